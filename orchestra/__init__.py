@@ -1,0 +1,3 @@
+"""orchestra: roslaunch-compatible launch and configuration orchestration, without ROS."""
+
+__version__ = "0.1.0"

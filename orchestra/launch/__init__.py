@@ -1,0 +1,1 @@
+"""The launch interpreter: launch files (XML or YAML) in, one immutable ``LaunchPlan`` out."""

@@ -1,0 +1,1 @@
+"""Process supervision: run a LaunchPlan's nodes, keep them healthy, stop them cleanly."""
