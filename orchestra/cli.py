@@ -17,8 +17,8 @@ from orchestra.errors import OrchestraError
 # name -> "module:attribute" of a click command or group
 COMMANDS: dict[str, str] = {
     "launch": "orchestra.launch.cli:launch",
-    "check": "orchestra.launch.cli:check",
-    "convert": "orchestra.launch.cli:convert",
+    "check": "orchestra.launch.tools_cli:check",
+    "convert": "orchestra.launch.tools_cli:convert",
     "pkg": "orchestra.packages.cli:pkg",
     "run": "orchestra.packages.cli:run",
     "create-pkg": "orchestra.packages.cli:create_pkg",
