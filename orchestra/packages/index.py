@@ -1,20 +1,30 @@
 """The package index: which package directory answers to which name.
 
-Built once per process (``get_index()``), so ``$(find pkg)`` costs a dict lookup; rospack's
-rules: the search path is ROS_PACKAGE_PATH then CMAKE_PREFIX_PATH ``share/`` dirs then the
-packages bundled with orchestra; a directory holding ``package.xml`` (or a legacy
-``manifest.xml``) is a package and is not descended into; ``CATKIN_IGNORE`` prunes a tree;
-the first package found under a name wins.
+Built once per process (``get_index()``), so ``$(find pkg)`` costs a dict lookup, and backed by
+an on-disk crawl cache (``cache.py``) so that a new process re-validates the previous crawl
+with one ``stat`` per directory instead of listing every directory and reading every manifest.
+
+rospack's rules: the roots (``discovery.search_roots``) are crawled in priority order; the
+first package found under a name wins and later ones are remembered as shadowed duplicates
+(``orchestra pkg list --duplicates``).
 """
 from __future__ import annotations
 
+import logging
 import os
 from dataclasses import dataclass, field
 
 from orchestra.errors import OrchestraError
+from orchestra.packages import cache
+from orchestra.packages.crawl import crawl
+from orchestra.packages.discovery import BUNDLED_PACKAGES, SearchRoot, search_path, search_roots
 
-BUNDLED_PACKAGES = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(
-    os.path.abspath(__file__)))), "packages")
+log = logging.getLogger(__name__)
+
+__all__ = ["BUNDLED_PACKAGES", "PackageIndex", "PackageNotFound", "find_package", "get_index",
+           "search_path", "reset_index"]
+
+_USE_DEFAULT = object()
 
 
 class PackageNotFound(OrchestraError):
@@ -22,66 +32,9 @@ class PackageNotFound(OrchestraError):
 
     def __init__(self, name: str):
         super().__init__(f"package '{name}' not found (searched ROS_PACKAGE_PATH, "
-                         "CMAKE_PREFIX_PATH and orchestra's bundled packages)")
+                         "CMAKE_PREFIX_PATH, the current catkin workspace and orchestra's "
+                         "bundled packages)")
         self.name = name
-
-
-def search_path(environ: dict[str, str] | None = None) -> list[str]:
-    """The directories searched for packages, in priority order."""
-    env = os.environ if environ is None else environ
-    roots: list[str] = []
-    for entry in env.get("ROS_PACKAGE_PATH", "").split(os.pathsep):
-        if entry:
-            roots.append(entry)
-    for prefix in env.get("CMAKE_PREFIX_PATH", "").split(os.pathsep):
-        if prefix:
-            roots.append(os.path.join(prefix, "share"))
-    roots.append(BUNDLED_PACKAGES)
-    return roots
-
-
-def _package_name(directory: str) -> str:
-    """The package's name: package.xml's <name> when it has one, else the directory name."""
-    manifest = os.path.join(directory, "package.xml")
-    try:
-        with open(manifest, "rb") as fh:
-            head = fh.read(4096)
-    except OSError:
-        return os.path.basename(directory)
-    start = head.find(b"<name>")
-    end = head.find(b"</name>", start)
-    if start >= 0 and end > start:
-        name = head[start + 6:end].decode("utf-8", "replace").strip()
-        if name:
-            return name
-    return os.path.basename(directory)
-
-
-def crawl(root: str) -> list[tuple[str, str]]:
-    """(name, directory) for every package below ``root``, in a stable depth-first order."""
-    found: list[tuple[str, str]] = []
-    if not os.path.isdir(root):
-        return found
-    stack = [os.path.abspath(root)]
-    while stack:
-        directory = stack.pop()
-        try:
-            entries = sorted(os.listdir(directory))
-        except OSError:
-            continue
-        names = set(entries)
-        if "CATKIN_IGNORE" in names:
-            continue
-        if "package.xml" in names or "manifest.xml" in names:
-            found.append((_package_name(directory), directory))
-            continue
-        for entry in reversed(entries):
-            if entry.startswith("."):
-                continue
-            path = os.path.join(directory, entry)
-            if os.path.isdir(path):
-                stack.append(path)
-    return found
 
 
 @dataclass
@@ -90,17 +43,34 @@ class PackageIndex:
 
     packages: dict[str, str] = field(default_factory=dict)
     duplicates: dict[str, list[str]] = field(default_factory=dict)
+    roots: list[SearchRoot] = field(default_factory=list)
+    #: package name -> the search root it was found under (for ``pkg list --verbose``)
+    origins: dict[str, SearchRoot] = field(default_factory=dict)
+    #: directories that had to be listed while building (0 = everything came from the cache)
+    listed: int = 0
 
     @classmethod
-    def build(cls, roots: list[str]) -> "PackageIndex":
+    def build(cls, roots: list[str] | list[SearchRoot], cache_dir=_USE_DEFAULT) -> "PackageIndex":
+        """Crawl ``roots`` in order; ``cache_dir=None`` disables the disk cache."""
+        if cache_dir is _USE_DEFAULT:
+            cache_dir = cache.default_cache_dir()
         index = cls()
         for root in roots:
-            for name, directory in crawl(root):
-                if name in index.packages:
-                    if index.packages[name] != directory:
-                        index.duplicates.setdefault(name, []).append(directory)
-                    continue
-                index.packages[name] = directory
+            if not isinstance(root, SearchRoot):
+                root = SearchRoot(os.path.normpath(os.path.abspath(root)), "explicit")
+            index.roots.append(root)
+            previous = cache.load(cache_dir, root.path)
+            result = crawl(root.path, previous)
+            index.listed += result.listed
+            if result.changed:
+                cache.save(cache_dir, root.path, result.records)
+            for name, directory in result.packages:
+                known = index.packages.get(name)
+                if known is None:
+                    index.packages[name] = directory
+                    index.origins[name] = root
+                elif known != directory and directory not in index.duplicates.get(name, ()):
+                    index.duplicates.setdefault(name, []).append(directory)
         return index
 
     def find(self, name: str) -> str:
@@ -109,17 +79,38 @@ class PackageIndex:
         except KeyError:
             raise PackageNotFound(name) from None
 
+    def __contains__(self, name: str) -> bool:
+        return name in self.packages
 
-_INDEX: tuple[tuple[str, ...], PackageIndex] | None = None
+    def names(self) -> list[str]:
+        return sorted(self.packages)
 
 
-def get_index() -> PackageIndex:
-    """The process-wide index, rebuilt only when the search path itself changes."""
+_INDEX: tuple[tuple, PackageIndex] | None = None
+
+
+def _key() -> tuple:
+    env = os.environ
+    try:
+        cwd = os.getcwd()
+    except OSError:  # the cwd was deleted under us
+        cwd = "/"
+    return (env.get("ROS_PACKAGE_PATH"), env.get("CMAKE_PREFIX_PATH"), env.get("ROS_HOME"), cwd)
+
+
+def get_index(refresh: bool = False) -> PackageIndex:
+    """The process-wide index, rebuilt only when the environment or cwd that define it change."""
     global _INDEX
-    roots = tuple(search_path())
-    if _INDEX is None or _INDEX[0] != roots:
-        _INDEX = (roots, PackageIndex.build(list(roots)))
+    key = _key()
+    if refresh or _INDEX is None or _INDEX[0] != key:
+        _INDEX = (key, PackageIndex.build(search_roots()))
     return _INDEX[1]
+
+
+def reset_index() -> None:
+    """Forget the process-wide index (tests; tools that just created a package)."""
+    global _INDEX
+    _INDEX = None
 
 
 def find_package(name: str) -> str:

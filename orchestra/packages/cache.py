@@ -1,0 +1,85 @@
+"""The on-disk crawl cache: one small JSON file per search root under ``$ROS_HOME/orchestra``.
+
+Why per root: processes with different ROS_PACKAGE_PATHs (tests, several workspaces) then
+never overwrite each other's work. Why atomic: many orchestra processes may start at once
+(``orchestra launch`` from scripts, parallel tests), so a file is written to a temporary name
+in the same directory and renamed over the old one; a reader sees either the old or the new
+file, never half of one. A lost race only costs the loser's next run a re-crawl.
+
+The cache is an optimisation only: an unreadable, corrupt or unwritable cache is ignored
+(logged at debug level) and never fails a command — the compat runner even runs orchestra
+with HOME unset.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import logging
+import os
+import tempfile
+from typing import Mapping
+
+from orchestra.packages.crawl import Record
+
+log = logging.getLogger(__name__)
+
+FORMAT = 1
+
+
+def default_cache_dir(environ: Mapping[str, str] | None = None) -> str | None:
+    """``$ROS_HOME/orchestra``, else ``~/.ros/orchestra``; None when no home can be found."""
+    env = os.environ if environ is None else environ
+    ros_home = env.get("ROS_HOME")
+    if ros_home:
+        return os.path.join(ros_home, "orchestra")
+    home = os.path.expanduser("~")  # falls back to the password database when HOME is unset
+    if not home or home == "~":
+        return None
+    return os.path.join(home, ".ros", "orchestra")
+
+
+def cache_file(cache_dir: str, root: str) -> str:
+    digest = hashlib.sha1(root.encode("utf-8", "surrogateescape")).hexdigest()[:16]
+    return os.path.join(cache_dir, f"packages-{digest}.json")
+
+
+def load(cache_dir: str | None, root: str) -> dict[str, Record]:
+    """The records saved for ``root``, or an empty dict when there are none usable."""
+    if cache_dir is None:
+        return {}
+    path = cache_file(cache_dir, root)
+    try:
+        with open(path, encoding="utf-8") as fh:
+            doc = json.load(fh)
+    except FileNotFoundError:
+        return {}
+    except (OSError, ValueError) as exc:
+        log.debug("ignoring unreadable package cache %s: %s", path, exc)
+        return {}
+    if not isinstance(doc, dict) or doc.get("format") != FORMAT or doc.get("root") != root:
+        return {}
+    records = doc.get("records")
+    return records if isinstance(records, dict) else {}
+
+
+def save(cache_dir: str | None, root: str, records: dict[str, Record]) -> bool:
+    """Atomically replace the cache file of ``root``; False (and no exception) on failure."""
+    if cache_dir is None:
+        return False
+    tmp = None
+    try:
+        os.makedirs(cache_dir, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=cache_dir, prefix=".packages-", suffix=".tmp")
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            json.dump({"format": FORMAT, "root": root, "records": records}, fh,
+                      separators=(",", ":"))
+        os.replace(tmp, cache_file(cache_dir, root))
+        return True
+    except OSError as exc:
+        log.debug("cannot write package cache in %s: %s", cache_dir, exc)
+        if tmp is not None:
+            try:
+                os.unlink(tmp)
+            except OSError:
+                pass
+        return False

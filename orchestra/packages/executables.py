@@ -1,0 +1,116 @@
+"""Finding a package's executable, the way roslaunch's ``<node type=...>`` and rosrun do.
+
+Where roslaunch looks, in order: the package's ``lib/<pkg>`` ("libexec") and ``share/<pkg>``
+directories in the first catkin devel/install space that has either, then the whole package
+tree (symlinks followed, hidden directories skipped). A candidate must be a regular file the
+user may execute. Several distinct matches in the same place are an error naming all of them
+(roslaunch silently takes the first one it happens to walk into).
+"""
+from __future__ import annotations
+
+import os
+from typing import Mapping
+
+from orchestra.errors import OrchestraError
+from orchestra.packages.discovery import catkin_prefixes
+from orchestra.packages.index import find_package
+
+
+class ExecutableNotFound(OrchestraError):
+    """No executable file of that name in the package."""
+
+
+class AmbiguousExecutable(OrchestraError):
+    """Several executables of that name in the package; ``candidates`` lists them."""
+
+    def __init__(self, message: str, candidates: list[str]):
+        super().__init__(message)
+        self.candidates = candidates
+
+
+def is_executable(path: str) -> bool:
+    """A regular file (symlinks followed) that the current user may execute."""
+    return os.path.isfile(path) and os.access(path, os.X_OK)
+
+
+def libexec_dirs(package: str, environ: Mapping[str, str] | None = None,
+                 cwd: str | None = None) -> list[str]:
+    """``lib/<pkg>`` and ``share/<pkg>`` of the first catkin prefix that has either."""
+    env = os.environ if environ is None else environ
+    here = os.getcwd() if cwd is None else cwd
+    for prefix in catkin_prefixes(env, here):
+        found = [d for d in (os.path.join(prefix, "lib", package),
+                             os.path.join(prefix, "share", package)) if os.path.isdir(d)]
+        if found:
+            return found
+    return []
+
+
+def _walk_matches(top: str, exe: str) -> list[str]:
+    """Executables named ``exe`` anywhere below ``top``, in a stable order."""
+    matches: list[str] = []
+    seen: set[str] = set()
+    for directory, dirs, files in os.walk(top, topdown=True, followlinks=True):
+        real = os.path.realpath(directory)
+        if real in seen:  # a symlink loop, or a tree reachable twice
+            dirs[:] = []
+            continue
+        seen.add(real)
+        dirs[:] = sorted(d for d in dirs if not d.startswith("."))
+        if exe in files:
+            candidate = os.path.join(directory, exe)
+            if is_executable(candidate):
+                matches.append(os.path.abspath(candidate))
+    return matches
+
+
+def _unique(paths: list[str]) -> list[str]:
+    """Drop repeats, including one file reached through two routes (symlinks)."""
+    unique: list[str] = []
+    reals: set[str] = set()
+    for path in paths:
+        real = os.path.realpath(path)
+        if real not in reals:
+            reals.add(real)
+            unique.append(path)
+    return unique
+
+
+def executable_candidates(package: str, exe: str, environ: Mapping[str, str] | None = None,
+                          cwd: str | None = None) -> list[str]:
+    """The executables ``exe`` of ``package`` in the first tier that has any.
+
+    The tiers are the catkin libexec dirs, then the package tree. A build product in
+    ``devel/lib/<pkg>`` deliberately wins over the source script it was made from (catkin's
+    relay scripts have the same name), as in roslaunch; only matches within one tier compete.
+    """
+    package_dir = find_package(package)
+    if os.sep in exe:  # a path relative to the package, as rosrun allows
+        candidate = os.path.join(package_dir, exe)
+        return [os.path.abspath(candidate)] if is_executable(candidate) else []
+    libexec: list[str] = []
+    for top in libexec_dirs(package, environ, cwd):
+        libexec += _walk_matches(top, exe)
+    if libexec:
+        return _unique(libexec)
+    return _unique(_walk_matches(package_dir, exe))
+
+
+def find_executable(package: str, exe: str) -> str:
+    """The absolute path of executable ``exe`` in ``package`` (for ``<node>`` and ``run``).
+
+    Raises ``PackageNotFound``, ``ExecutableNotFound`` or ``AmbiguousExecutable`` (all
+    ``OrchestraError``), whose messages say what to fix.
+    """
+    matches = executable_candidates(package, exe)
+    if not matches:
+        raise ExecutableNotFound(
+            f"cannot find executable '{exe}' in package '{package}' "
+            f"({find_package(package)}): the file must exist in the package (or its catkin "
+            "lib/ directory) and be executable (chmod +x)")
+    if len(matches) > 1:
+        listing = ", ".join(matches)
+        raise AmbiguousExecutable(
+            f"several executables named '{exe}' in package '{package}': {listing}; "
+            "remove or rename all but one", matches)
+    return matches[0]
