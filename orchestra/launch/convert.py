@@ -1,0 +1,266 @@
+"""``orchestra convert``: move launch files between XML and YAML without changing their meaning.
+
+Both directions go through the Entity tree (file -> Entity -> text), so a conversion is
+exactly as lossless as the Entity: tags, attributes (raw strings, in order) and element text
+survive byte for byte; XML comments, attribute quoting style and YAML anchors do not (the
+Entity has no place for them).
+
+Converting a single file leaves its ``<include file=...>`` references alone: the interpreter
+reads mixed trees (an XML file may include a YAML file and the other way round), so the result
+launches the same thing. Converting a directory converts every launch file in it and rewrites
+an include whose file name is one of the files converted in the same run, so a package can be
+moved over to YAML in one step; the original files are kept beside the new ones.
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+
+import yaml as pyyaml
+from lxml import etree
+from yaml.nodes import MappingNode, ScalarNode, SequenceNode
+
+from orchestra.errors import Location, OrchestraError
+from orchestra.launch import yaml as yaml_frontend
+from orchestra.launch.entity import Entity
+
+FORMATS = ("yaml", "xml")
+_RESOLVER = pyyaml.resolver.Resolver()
+_STR_TAG = "tag:yaml.org,2002:str"
+_MAP_TAG = "tag:yaml.org,2002:map"
+_SEQ_TAG = "tag:yaml.org,2002:seq"
+# A leaf element is written on one line (`- arg: {name: x, default: 1}`) when it fits.
+_FLOW_WIDTH = 100
+
+
+class ConvertError(OrchestraError):
+    """A file that cannot be converted (unreadable, or not expressible in the target)."""
+
+
+def format_of(path: str) -> str:
+    """``"yaml"`` or ``"xml"``: which front end reads ``path`` (by its extension)."""
+    return "yaml" if yaml_frontend.is_yaml_launch_file(path) else "xml"
+
+
+def load_entity(path: str) -> Entity:
+    """The root Entity of a launch file, read by the front end its extension calls for."""
+    if format_of(path) == "yaml":
+        return yaml_frontend.parse_file(path)
+    from orchestra.launch import xml as xml_frontend  # the other engineer's front end
+
+    return xml_frontend.parse_file(path)
+
+
+def to_text(entity: Entity, fmt: str) -> str:
+    """The launch file text of ``entity`` in format ``fmt`` ("yaml" or "xml")."""
+    if fmt == "yaml":
+        return to_yaml(entity)
+    if fmt == "xml":
+        return to_xml(entity)
+    raise ConvertError(f"unknown target format '{fmt}' (expected one of {', '.join(FORMATS)})")
+
+
+# --------------------------------------------------------------------------- Entity -> YAML
+
+
+class _IndentedDumper(pyyaml.SafeDumper):
+    """Indents lists under their key (``launch:\\n  - node:``), as people write them by hand."""
+
+    def increase_indent(self, flow: bool = False, indentless: bool = False) -> None:
+        super().increase_indent(flow, False)
+
+
+def _scalar(value: str, style: str | None = None) -> ScalarNode:
+    # Tag the scalar with what YAML would read the plain text as: the serializer then sees
+    # the plain form as implicit and writes `true`/`1.10` unquoted. The YAML front end reads
+    # the scalar's text, not its type, so the string comes back unchanged either way.
+    if style is None:
+        tag = _RESOLVER.resolve(ScalarNode, value, (True, False))
+    else:
+        tag = _STR_TAG
+    return ScalarNode(tag, value, style=style)
+
+
+def _entity_node(entity: Entity) -> MappingNode:
+    """``{tag: body}``: the one-key mapping that is a list item of the YAML schema."""
+    return MappingNode(_MAP_TAG, [(_scalar(entity.tag), _body_node(entity))])
+
+
+def _body_node(entity: Entity):
+    for name in entity.attributes:
+        if name in yaml_frontend.RESERVED_KEYS:
+            raise ConvertError(f"<{entity.tag}> has an attribute named '{name}', which the "
+                               "YAML schema reserves; it cannot be written as YAML",
+                               entity.location)
+    if not entity.attributes and entity.text is None:
+        if not entity.children:
+            return _scalar("")  # `- group:` : nothing in it
+        return _children_node(entity.children)
+    pairs = [(_scalar(name), _scalar(value)) for name, value in entity.attributes.items()]
+    if entity.text is not None:
+        style = "|" if "\n" in entity.text else None
+        pairs.append((_scalar(yaml_frontend.TEXT_KEY), _scalar(entity.text, style)))
+    if entity.children:
+        pairs.append((_scalar(yaml_frontend.CHILDREN_KEY), _children_node(entity.children)))
+    flow = (not entity.children and entity.text is None
+            and sum(len(k.value) + len(v.value) + 4 for k, v in pairs) < _FLOW_WIDTH)
+    return MappingNode(_MAP_TAG, pairs, flow_style=flow)
+
+
+def _children_node(children: list[Entity]) -> SequenceNode:
+    return SequenceNode(_SEQ_TAG, [_entity_node(child) for child in children],
+                        flow_style=False)
+
+
+def to_yaml(entity: Entity) -> str:
+    """YAML launch text that the YAML front end reads back into an Entity equal to ``entity``."""
+    document = MappingNode(_MAP_TAG, [(_scalar(entity.tag), _body_node(entity))],
+                           flow_style=False)
+    return pyyaml.serialize(document, Dumper=_IndentedDumper, allow_unicode=True,
+                            width=_FLOW_WIDTH)
+
+
+# ---------------------------------------------------------------------------- Entity -> XML
+
+
+def _xml_element(entity: Entity, depth: int) -> etree._Element:
+    try:
+        element = etree.Element(entity.tag)
+    except ValueError:
+        raise ConvertError(f"'{entity.tag}' is not a valid XML tag name",
+                           entity.location) from None
+    for name, value in entity.attributes.items():
+        try:
+            element.set(name, value)
+        except ValueError:
+            raise ConvertError(f"attribute '{name}' of <{entity.tag}> cannot be written as "
+                               "XML (invalid name or value)", entity.location) from None
+    indent = "\n" + "  " * (depth + 1)
+    if entity.text is not None:
+        element.text = entity.text
+    elif entity.children:
+        # indentation only: whitespace-only element text is not part of an Entity
+        element.text = indent
+    for index, child in enumerate(entity.children):
+        sub = _xml_element(child, depth + 1)
+        last = index == len(entity.children) - 1
+        sub.tail = "\n" + "  " * depth if last else indent
+        element.append(sub)
+    return element
+
+
+def to_xml(entity: Entity) -> str:
+    """XML launch text that the XML front end reads back into an Entity equal to ``entity``."""
+    root = _xml_element(entity, 0)
+    body = etree.tostring(root, encoding="unicode")
+    return '<?xml version="1.0"?>\n' + body + "\n"
+
+
+# ------------------------------------------------------------------------------ whole files
+
+
+def target_name(path: str, fmt: str) -> str:
+    """Where the converted ``path`` goes: ``x.launch`` <-> ``x.launch.yaml``."""
+    directory, name = os.path.split(path)
+    lower = name.lower()
+    if fmt == "yaml":
+        if lower.endswith(".launch.xml"):
+            name = name[: -len(".xml")]
+        return os.path.join(directory, name + ".yaml")
+    for suffix in (".launch.yaml", ".launch.yml"):
+        if lower.endswith(suffix):
+            return os.path.join(directory, name[: -len(suffix)] + ".launch")
+    stem, _ = os.path.splitext(name)
+    return os.path.join(directory, stem + ".launch")
+
+
+def convert_file(path: str, fmt: str) -> str:
+    """The text of launch file ``path`` converted to ``fmt`` (includes are left as written)."""
+    return to_text(load_entity(path), fmt)
+
+
+@dataclass(frozen=True)
+class Converted:
+    """One file written by a directory conversion."""
+
+    source: str
+    target: str
+
+
+def is_launch_file(path: str, fmt_from: str) -> bool:
+    """Whether ``path`` looks like a launch file of format ``fmt_from`` (cheap sniff, no parse).
+
+    XML: ``*.launch`` or an ``*.xml`` whose root element is ``<launch>`` (package.xml and URDF
+    files are not). YAML: a ``*.yaml``/``*.yml`` file whose first key is ``launch:``
+    (rosparam files are not).
+    """
+    lower = path.lower()
+    if fmt_from == "xml":
+        if lower.endswith(".launch"):
+            return True
+        if not lower.endswith(".xml"):
+            return False
+        try:
+            for _, element in etree.iterparse(path, events=("start",), recover=True):
+                return element.tag == "launch"
+        except (etree.XMLSyntaxError, OSError):
+            return False
+        return False
+    if not yaml_frontend.is_yaml_launch_file(path):
+        return False
+    try:
+        with open(path, encoding="utf-8") as fh:
+            for line in fh:
+                stripped = line.strip()
+                if not stripped or stripped.startswith("#") or stripped == "---":
+                    continue
+                return stripped.startswith("launch:")
+    except (OSError, UnicodeDecodeError):
+        return False
+    return False
+
+
+def convert_tree(directory: str, fmt: str) -> list[Converted]:
+    """Convert every launch file under ``directory`` to ``fmt``, writing each beside its source.
+
+    Include ``file=`` values whose last path component names a file converted in this run are
+    rewritten to the new name; others are left as written (the source files stay, and the
+    interpreter reads mixed trees, so they still resolve). Every file is parsed before any is
+    written, so a bad file leaves the tree untouched.
+    """
+    fmt_from = "xml" if fmt == "yaml" else "yaml"
+    sources: list[str] = []
+    for root, dirs, files in os.walk(directory):
+        dirs.sort()
+        for name in sorted(files):
+            path = os.path.join(root, name)
+            if is_launch_file(path, fmt_from):
+                sources.append(path)
+    renames = {os.path.basename(src): os.path.basename(target_name(src, fmt)) for src in sources}
+    results: list[tuple[str, str]] = []
+    taken: dict[str, str] = {}
+    for src in sources:
+        target = target_name(src, fmt)
+        if target in taken:
+            raise ConvertError(f"both {taken[target]} and {src} would be converted to "
+                               f"{target}", Location(src))
+        taken[target] = src
+        entity = load_entity(src)
+        _rewrite_includes(entity, renames)
+        results.append((target, to_text(entity, fmt)))
+    for target, text in results:
+        with open(target, "w", encoding="utf-8") as fh:
+            fh.write(text)
+    return [Converted(src, target) for src, (target, _) in zip(sources, results)]
+
+
+def _rewrite_includes(entity: Entity, renames: dict[str, str]) -> None:
+    """Point ``<include file=...>`` at the converted file when it was converted too."""
+    if entity.tag == "include":
+        value = entity.get("file")
+        if value:
+            head, sep, last = value.rpartition("/")
+            if last in renames:
+                entity.attributes["file"] = head + sep + renames[last]
+    for child in entity.children:
+        _rewrite_includes(child, renames)
