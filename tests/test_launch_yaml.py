@@ -1,0 +1,181 @@
+"""The YAML launch front end: schema, lossless scalar text, locations, refusals."""
+from __future__ import annotations
+
+import pytest
+
+from orchestra.errors import Location, OrchestraError
+from orchestra.launch.entity import Entity
+from orchestra.launch.yaml import parse_file, parse_string
+
+
+def parse(text: str) -> Entity:
+    return parse_string(text, "t.launch.yaml")
+
+
+def error_of(text: str) -> OrchestraError:
+    with pytest.raises(OrchestraError) as info:
+        parse(text)
+    return info.value
+
+
+def test_launch_children_become_entities_in_order():
+    root = parse("launch:\n  - arg: {name: a}\n  - node: {pkg: p, type: t, name: n}\n")
+    assert root.tag == "launch"
+    assert [c.tag for c in root.children] == ["arg", "node"]
+    assert root.children[1].attributes == {"pkg": "p", "type": "t", "name": "n"}
+
+
+def test_attribute_order_is_file_order():
+    root = parse("launch:\n  - node: {name: n, type: t, pkg: p}\n")
+    assert list(root.children[0].attributes) == ["name", "type", "pkg"]
+
+
+@pytest.mark.parametrize("written, raw", [
+    ("true", "true"), ("True", "True"), ("1.10", "1.10"), ("0x1F", "0x1F"), ("1e3", "1e3"),
+    ("~", "~"), ("null", "null"), ("", ""), ("'007'", "007"), ('"a\\tb"', "a\tb"),
+    ("$(find pkg)/x.yaml", "$(find pkg)/x.yaml"), ("2001-12-14", "2001-12-14"),
+    ("-1", "-1"), (".inf", ".inf"), ("yes", "yes"),
+])
+def test_scalar_attribute_is_the_text_as_written(written, raw):
+    root = parse(f"launch:\n  - param:\n      name: p\n      value: {written}\n")
+    assert root.children[0].get("value") == raw
+
+
+def test_element_text_goes_under_text_key_verbatim():
+    root = parse("launch:\n  - rosparam:\n      command: load\n      text: |\n"
+                 "        a: 1\n        b: !degrees 90\n")
+    rosparam = root.children[0]
+    assert rosparam.attributes == {"command": "load"}
+    assert rosparam.text == "a: 1\nb: !degrees 90\n"
+
+
+def test_children_key_nests_elements():
+    root = parse("launch:\n  - group:\n      ns: g\n      children:\n"
+                 "        - node: {pkg: p, type: t, name: n}\n")
+    group = root.children[0]
+    assert group.attributes == {"ns": "g"}
+    assert [c.tag for c in group.children] == ["node"]
+
+
+def test_list_body_is_children_without_attributes():
+    root = parse("launch:\n  - group:\n    - param: {name: a, value: 1}\n")
+    assert root.children[0].attributes == {}
+    assert root.children[0].children[0].tag == "param"
+
+
+def test_nested_lists_are_flattened_into_children():
+    root = parse("launch:\n  - - arg: {name: a}\n    - arg: {name: b}\n  - arg: {name: c}\n")
+    assert [c.get("name") for c in root.children] == ["a", "b", "c"]
+
+
+def test_empty_element_body_is_an_element_with_nothing():
+    root = parse("launch:\n  - group:\n")
+    assert root.children == [Entity("group", location=root.children[0].location)]
+
+
+def test_ros2_aliases_map_to_roslaunch_attribute_names():
+    root = parse("launch:\n  - node: {pkg: p, exec: t, name: n, namespace: ns}\n"
+                 "  - arg: {name: a, description: the a}\n")
+    assert root.children[0].attributes == {"pkg": "p", "type": "t", "name": "n", "ns": "ns"}
+    assert root.children[1].get("doc") == "the a"
+
+
+def test_alias_and_canonical_name_together_is_an_error():
+    err = error_of("launch:\n  - node: {pkg: p, exec: t, type: u}\n")
+    assert "type" in err.message
+    assert err.location == Location("t.launch.yaml", 2, 29)
+
+
+def test_ros2_style_child_lists_under_a_tag_key():
+    root = parse("launch:\n  - node:\n      pkg: p\n      type: t\n      param:\n"
+                 "        - {name: a, value: 1}\n        - {name: b, value: 2}\n"
+                 "      remap: {from: x, to: y}\n")
+    node = root.children[0]
+    assert [(c.tag, c.get("name") or c.get("from")) for c in node.children] == [
+        ("param", "a"), ("param", "b"), ("remap", "x")]
+
+
+def test_structured_value_for_a_non_tag_key_is_refused_with_hint():
+    err = error_of("launch:\n  - param:\n      name: p\n      value: [1, 2]\n")
+    assert "must be a single value" in err.message and "value" in err.message
+    assert err.location.line == 4
+
+
+def test_merge_keys_share_attributes_and_own_keys_win():
+    root = parse("launch:\n  - node:\n      <<: {output: screen, respawn: 'true'}\n"
+                 "      pkg: p\n      respawn: 'false'\n")
+    assert root.children[0].attributes == {"output": "screen", "respawn": "false", "pkg": "p"}
+
+
+def test_entities_carry_file_line_and_column_of_their_tag():
+    root = parse("launch:\n  - arg: {name: a}\n  - group:\n      children:\n"
+                 "        - node: {pkg: p, type: t}\n")
+    assert root.location == Location("t.launch.yaml", 1, 1)
+    assert root.children[0].location == Location("t.launch.yaml", 2, 5)
+    assert root.children[1].children[0].location == Location("t.launch.yaml", 5, 11)
+
+
+def test_attribute_locations_are_recorded_per_attribute():
+    root = parse("launch:\n  - node:\n      pkg: p\n      typo: t\n")
+    assert root.children[0].attribute_locations["typo"] == Location("t.launch.yaml", 4, 7)
+
+
+def test_python_object_tag_is_refused():
+    err = error_of("launch:\n  - param: !!python/object:os.system {name: x}\n")
+    assert "python/object" in err.message
+    assert err.location.line == 2
+
+
+def test_python_tag_inside_a_value_is_refused():
+    err = error_of("launch:\n  - param: {name: x, value: !!python/name:os.system ''}\n")
+    assert "not allowed" in err.message
+
+
+def test_custom_tag_in_inline_rosparam_text_is_just_text():
+    root = parse("launch:\n  - rosparam:\n      text: 'angle: !degrees 90'\n")
+    assert root.children[0].text == "angle: !degrees 90"
+
+
+def test_malformed_yaml_reports_file_and_line():
+    err = error_of("launch:\n  - node: {pkg: p\n")
+    assert err.location.file == "t.launch.yaml"
+    assert err.location.line is not None
+    assert "invalid YAML" in err.message
+
+
+def test_duplicate_key_is_an_error_not_last_wins():
+    err = error_of("launch:\n  - node:\n      name: a\n      name: b\n")
+    assert "duplicate key 'name'" in err.message
+    assert err.location.line == 4
+
+
+@pytest.mark.parametrize("text, fragment", [
+    ("", "empty launch file"),
+    ("# only a comment\n", "empty launch file"),
+    ("- launch: []\n", "single key 'launch:'"),
+    ("launch: []\nother: []\n", "single key 'launch:'"),
+    ("launch: [a]\n", "one element"),
+    ("launch:\n  - {node: {}, arg: {}}\n", "exactly one key"),
+    ("launch:\n  - node: 3\n", "mapping of attributes"),
+    ("launch:\n  - rosparam: {text: {a: 1}}\n", "must be a string"),
+    ("launch:\n  - group: {children: {node: {}}}\n", "must be a list"),
+    ("launch: []\n---\nlaunch: []\n", "exactly one document"),
+    ("launch:\n  - {[a]: 1}\n", "plain name"),
+])
+def test_wrong_shape_is_a_located_error(text, fragment):
+    err = error_of(text)
+    assert fragment in err.message
+    assert err.location is not None and err.location.file == "t.launch.yaml"
+
+
+def test_parse_file_reads_from_disk_and_names_the_path(tmp_path):
+    path = tmp_path / "x.launch.yaml"
+    path.write_text("launch:\n  - arg: {name: a}\n")
+    root = parse_file(str(path))
+    assert root.children[0].location.file == str(path)
+
+
+def test_parse_file_missing_is_an_orchestra_error(tmp_path):
+    with pytest.raises(OrchestraError) as info:
+        parse_file(str(tmp_path / "none.launch.yaml"))
+    assert "not found" in info.value.message
