@@ -1,0 +1,89 @@
+"""Talking to a master (ours or a real rosmaster) from tools: find it, probe it, upload.
+
+Everything here speaks plain XML-RPC, so the same code drives an orchestra master, an
+embedded one, or ROS's own rosmaster.
+"""
+from __future__ import annotations
+
+import os
+import socket
+import urllib.parse
+import xmlrpc.client
+from http.client import HTTPException
+from typing import Any, Mapping, Sequence
+
+from orchestra.errors import OrchestraError
+from orchestra.master.notify import TimeoutTransport
+from orchestra.params.tree import check_value
+
+DEFAULT_MASTER_URI = "http://localhost:11311/"
+DEFAULT_PORT = 11311
+
+# what goes wrong on the wire when nobody (or something odd) answers
+TRANSPORT_ERRORS = (OSError, HTTPException, xmlrpc.client.ProtocolError,
+                    xmlrpc.client.ResponseError)
+
+
+class MasterUnreachable(OrchestraError):
+    """No master answers at the given URI."""
+
+    exit_code = 1
+
+
+def master_uri_from_env(environ: Mapping[str, str] | None = None) -> str:
+    """ROS_MASTER_URI, or roscore's default ``http://localhost:11311/``."""
+    env = os.environ if environ is None else environ
+    return env.get("ROS_MASTER_URI") or DEFAULT_MASTER_URI
+
+
+def port_from_uri(uri: str) -> int:
+    """The TCP port of a master URI (11311 when the URI names none)."""
+    try:
+        port = urllib.parse.urlsplit(uri).port
+    except ValueError:
+        raise OrchestraError(f"invalid master URI '{uri}' (expected http://host:port/)") from None
+    return port if port is not None else DEFAULT_PORT
+
+
+def proxy(uri: str, timeout: float | None = None) -> xmlrpc.client.ServerProxy:
+    """An XML-RPC proxy for ``uri``; ``timeout`` bounds each call (None = wait forever)."""
+    transport = TimeoutTransport(timeout) if timeout is not None else None
+    return xmlrpc.client.ServerProxy(uri, transport=transport)
+
+
+def master_is_up(uri: str, timeout: float = 1.0) -> bool:
+    """True when something at ``uri`` answers ``getPid`` like a ROS master."""
+    try:
+        code, _, _ = proxy(uri, timeout).getPid("/orchestra")
+    except (*TRANSPORT_ERRORS, xmlrpc.client.Fault, ValueError, TypeError, socket.timeout):
+        return False
+    return code == 1
+
+
+def upload_params(master_uri: str, params: Mapping[str, Any], clear_params: Sequence[str],
+                  caller_id: str = "/roslaunch") -> None:
+    """Clear ``clear_params`` namespaces then set every param, in ONE system.multicall.
+
+    Values are checked first, so a value XML-RPC cannot carry fails before anything is sent
+    (nothing half-uploaded). Deleting a namespace that is not set answers -1, which is fine:
+    roslaunch's clear_params means "make sure it is empty".
+    """
+    for name, value in params.items():
+        check_value(name, value)
+    server = proxy(master_uri, timeout=30.0)
+    multi = xmlrpc.client.MultiCall(server)
+    for ns in clear_params:
+        multi.deleteParam(caller_id, ns)
+    names = list(params)
+    for name in names:
+        multi.setParam(caller_id, name, params[name])
+    try:
+        results = list(multi())
+    except xmlrpc.client.Fault as exc:
+        raise OrchestraError(f"master at {master_uri} refused the parameters: "
+                             f"{exc.faultString}") from None
+    except TRANSPORT_ERRORS as exc:
+        raise MasterUnreachable(f"cannot reach the master at {master_uri}: {exc}") from None
+    for name, (code, message, _) in zip(names, results[len(clear_params):]):
+        if code != 1:
+            raise OrchestraError(f"master refused parameter '{name}': {message}")

@@ -1,0 +1,84 @@
+"""The XML-RPC transport of the master: a threaded stdlib server with keep-alive.
+
+One thread per connection (``ThreadingMixIn``); HTTP/1.1 so that clients which keep their
+connection open (xmlrpc.client does) pay the TCP set-up once. Open connections are tracked so
+``close()`` really ends them: an idle keep-alive connection must not keep a thread, or a
+port, alive after the master is gone.
+"""
+from __future__ import annotations
+
+import logging
+import os
+import socket
+import socketserver
+import threading
+from xmlrpc.server import SimpleXMLRPCRequestHandler, SimpleXMLRPCServer
+
+log = logging.getLogger(__name__)
+
+LOCALHOST_NAMES = ("localhost", "127.0.0.1", "::1")
+
+
+class _Handler(SimpleXMLRPCRequestHandler):
+    protocol_version = "HTTP/1.1"
+    rpc_paths = ()  # rospy and roscpp post to "/", others to "/RPC2": accept any path
+    # an idle keep-alive connection is closed after this long (seconds)
+    timeout = 60
+
+    def log_message(self, format, *args):  # route http.server chatter to logging
+        log.debug("%s " + format, self.address_string(), *args)
+
+
+class ThreadedXMLRPCServer(socketserver.ThreadingMixIn, SimpleXMLRPCServer):
+    """SimpleXMLRPCServer answering each connection in its own daemon thread."""
+
+    daemon_threads = True
+    block_on_close = False
+    allow_reuse_address = True
+    request_queue_size = 128
+
+    def __init__(self, addr: tuple[str, int]):
+        family = socket.AF_INET6 if ":" in addr[0] else socket.AF_INET
+        self.address_family = family
+        super().__init__(addr, requestHandler=_Handler, logRequests=False, allow_none=False,
+                         bind_and_activate=True)
+        self._connections: set[socket.socket] = set()
+        self._conn_lock = threading.Lock()
+
+    def process_request(self, request, client_address):
+        with self._conn_lock:
+            self._connections.add(request)
+        super().process_request(request, client_address)
+
+    def shutdown_request(self, request):
+        with self._conn_lock:
+            self._connections.discard(request)
+        super().shutdown_request(request)
+
+    def close_connections(self) -> None:
+        """End every open client connection (their handler threads then exit)."""
+        with self._conn_lock:
+            connections = list(self._connections)
+        for conn in connections:
+            try:
+                conn.shutdown(socket.SHUT_RDWR)
+            except OSError:
+                pass
+
+
+def bind_address(host: str | None = None, environ: dict[str, str] | None = None
+                 ) -> tuple[str, str]:
+    """(address to bind, host name to advertise in URIs) for a master.
+
+    Default is loopback only: a master reachable from the network lets anyone start and stop
+    nodes. An explicit ``host`` wins; otherwise ROS_IP / ROS_HOSTNAME (ROS's own way to say
+    "reachable from elsewhere") open it on all interfaces, advertised under that name.
+    """
+    env = os.environ if environ is None else environ
+    if host:
+        advertised = host if host not in ("0.0.0.0", "::", "") else socket.gethostname()
+        return host, advertised
+    public = env.get("ROS_HOSTNAME") or env.get("ROS_IP")
+    if public and public not in LOCALHOST_NAMES:
+        return "0.0.0.0", public
+    return "127.0.0.1", "127.0.0.1"
