@@ -86,23 +86,44 @@ def _entity_node(entity: Entity) -> MappingNode:
     return MappingNode(_MAP_TAG, [(_scalar(entity.tag), _body_node(entity))])
 
 
+def significant_text(entity: Entity) -> str | None:
+    """The element's text, or None when it is only whitespace.
+
+    The XML front end hands over every character between the tags, so an element with
+    children carries its indentation as text. That whitespace is layout, not content (no tag
+    rule reads it), and keeping it would litter every converted YAML element with
+    ``text: "\n  \n"``; so both writers drop whitespace-only text, and "lossless" means
+    equal Entities once layout whitespace is taken as no text (``without_layout``).
+    """
+    text = entity.text
+    return None if text is None or not text.strip() else text
+
+
+def without_layout(entity: Entity) -> Entity:
+    """A copy of ``entity`` with whitespace-only text removed throughout (see above)."""
+    return Entity(tag=entity.tag, attributes=dict(entity.attributes),
+                  children=[without_layout(child) for child in entity.children],
+                  text=significant_text(entity), location=entity.location)
+
+
 def _body_node(entity: Entity):
     for name in entity.attributes:
         if name in yaml_frontend.RESERVED_KEYS:
             raise ConvertError(f"<{entity.tag}> has an attribute named '{name}', which the "
                                "YAML schema reserves; it cannot be written as YAML",
                                entity.location)
-    if not entity.attributes and entity.text is None:
+    text = significant_text(entity)
+    if not entity.attributes and text is None:
         if not entity.children:
             return _scalar("")  # `- group:` : nothing in it
         return _children_node(entity.children)
     pairs = [(_scalar(name), _scalar(value)) for name, value in entity.attributes.items()]
-    if entity.text is not None:
-        style = "|" if "\n" in entity.text else None
-        pairs.append((_scalar(yaml_frontend.TEXT_KEY), _scalar(entity.text, style)))
+    if text is not None:
+        style = "|" if "\n" in text else None
+        pairs.append((_scalar(yaml_frontend.TEXT_KEY), _scalar(text, style)))
     if entity.children:
         pairs.append((_scalar(yaml_frontend.CHILDREN_KEY), _children_node(entity.children)))
-    flow = (not entity.children and entity.text is None
+    flow = (not entity.children and text is None
             and sum(len(k.value) + len(v.value) + 4 for k, v in pairs) < _FLOW_WIDTH)
     return MappingNode(_MAP_TAG, pairs, flow_style=flow)
 
@@ -135,16 +156,17 @@ def _xml_element(entity: Entity, depth: int) -> etree._Element:
         except ValueError:
             raise ConvertError(f"attribute '{name}' of <{entity.tag}> cannot be written as "
                                "XML (invalid name or value)", entity.location) from None
-    indent = "\n" + "  " * (depth + 1)
-    if entity.text is not None:
-        element.text = entity.text
-    elif entity.children:
-        # indentation only: whitespace-only element text is not part of an Entity
-        element.text = indent
+    text = significant_text(entity)
+    # Indent children only when the element has no text of its own: the XML front end reads
+    # text and the whitespace between children as one string, so indenting around real text
+    # would change it.
+    indent = "\n" + "  " * (depth + 1) if text is None else None
+    element.text = text if text is not None else (indent if entity.children else None)
     for index, child in enumerate(entity.children):
         sub = _xml_element(child, depth + 1)
-        last = index == len(entity.children) - 1
-        sub.tail = "\n" + "  " * depth if last else indent
+        if indent is not None:
+            last = index == len(entity.children) - 1
+            sub.tail = "\n" + "  " * depth if last else indent
         element.append(sub)
     return element
 

@@ -1,0 +1,184 @@
+"""``orchestra convert``: XML <-> YAML without changing what a launch file means."""
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from conftest import COMPAT
+from orchestra.errors import OrchestraError
+from orchestra.launch import convert, xml as xml_frontend, yaml as yaml_frontend
+from orchestra.launch.entity import Entity
+
+WS = COMPAT / "ws"
+SMOKE = json.loads((COMPAT / "smoke.json").read_text()) if COMPAT.is_dir() else []
+
+
+def shape(entity: Entity):
+    """What an Entity means, without where it was written (locations differ across files)."""
+    entity = convert.without_layout(entity)
+
+    def walk(e: Entity):
+        return (e.tag, list(e.attributes.items()), e.text, [walk(c) for c in e.children])
+    return walk(entity)
+
+
+def run_cli(*args, env=None, cwd=None):
+    return subprocess.run([sys.executable, "-m", "orchestra", *args], capture_output=True,
+                          text=True, timeout=60, env=env, cwd=cwd)
+
+
+# ------------------------------------------------------------------ the whole smoke corpus
+
+@pytest.mark.parametrize("launch_file", [item["launch_file"] for item in SMOKE])
+def test_xml_to_yaml_to_xml_round_trip_keeps_every_entity(launch_file):
+    path = str(WS / launch_file)
+    try:
+        original = xml_frontend.parse_file(path)
+    except OrchestraError:
+        # not XML at all (a symlink flattened to its target's name): convert must refuse it
+        # the same way, with an error instead of output
+        with pytest.raises(OrchestraError):
+            convert.convert_file(path, "yaml")
+        return
+    yaml_text = convert.to_yaml(original)
+    from_yaml = yaml_frontend.parse_string(yaml_text, launch_file + ".yaml")
+    assert shape(from_yaml) == shape(original)
+    xml_text = convert.to_xml(from_yaml)
+    back = xml_frontend.parse_string(xml_text, launch_file)
+    assert shape(back) == shape(original)
+
+
+def test_converted_yaml_keeps_line_numbers_meaningful():
+    original = xml_frontend.parse_file(str(WS / "turtle_tf/launch/turtle_tf_demo.launch"))
+    yaml_text = convert.to_yaml(original)
+    root = yaml_frontend.parse_string(yaml_text, "demo.launch.yaml")
+    lines = yaml_text.splitlines()
+    for child in root.children:
+        assert lines[child.location.line - 1].strip().startswith(f"- {child.tag}:")
+
+
+# ---------------------------------------------------------------------- awkward strings
+
+AWKWARD = ["", " lead", "trail ", "a: b", "#hash", "x #y", "[1, 2]", "{a: 1}", "yes", "~",
+           "null", "1.10", "0o17", "'quoted'", '"dq"', "tab\there", "new\nline", "ünï",
+           "- dash", "@at", "`tick", "$(arg a) $(find b)", "%percent", "a|b", "> gt", "*star",
+           "&amp", "!bang", "<lt>", "a,b", "x" * 150, "multi  space"]
+
+
+@pytest.mark.parametrize("value", AWKWARD)
+def test_awkward_attribute_values_survive_both_directions(value):
+    entity = Entity("launch", children=[Entity("param", {"name": "p", "value": value})])
+    from_yaml = yaml_frontend.parse_string(convert.to_yaml(entity), "x.yaml")
+    assert from_yaml.children[0].get("value") == value
+    from_xml = xml_frontend.parse_string(convert.to_xml(entity), "x.launch")
+    assert from_xml.children[0].get("value") == value
+
+
+@pytest.mark.parametrize("text", [
+    "\n    a: 1\n    b: [1, 2]\n  ",          # closing tag indented: trailing spaces
+    "\n  a: 1\n",
+    "a: 1",
+    "  leading: indent\n",
+    "x: !degrees 90\ny: !!binary aGk=\n",
+    "\ta: tab\n",
+    "a: 1\n\n\n",
+])
+def test_rosparam_text_survives_both_directions_exactly(text):
+    entity = Entity("launch", children=[Entity("rosparam", {"command": "load"}, text=text)])
+    yaml_text = convert.to_yaml(entity)
+    assert yaml_frontend.parse_string(yaml_text, "x.yaml").children[0].text == text
+    assert xml_frontend.parse_string(convert.to_xml(entity), "x").children[0].text == text
+
+
+def test_multiline_rosparam_text_is_written_as_a_literal_block():
+    entity = Entity("launch", children=[Entity("rosparam", {}, text="\n  a: 1\n  b: 2\n")])
+    assert "text: |" in convert.to_yaml(entity)
+
+
+def test_leaf_elements_are_written_on_one_line():
+    entity = Entity("launch", children=[Entity("arg", {"name": "a", "default": "true"})])
+    assert convert.to_yaml(entity) == "launch:\n  - arg: {name: a, default: true}\n"
+
+
+def test_reserved_attribute_name_cannot_be_written_as_yaml():
+    entity = Entity("launch", children=[Entity("node", {"children": "x"})])
+    with pytest.raises(OrchestraError, match="reserves"):
+        convert.to_yaml(entity)
+
+
+def test_yaml_aliases_are_written_back_with_roslaunch_names(tmp_path):
+    src = tmp_path / "a.launch.yaml"
+    src.write_text("launch:\n  - node: {pkg: p, exec: t, namespace: n}\n")
+    xml_text = convert.convert_file(str(src), "xml")
+    node = xml_frontend.parse_string(xml_text, "a.launch").children[0]
+    assert node.attributes == {"pkg": "p", "type": "t", "ns": "n"}
+
+
+# ------------------------------------------------------------------------------ the CLI
+
+def test_cli_convert_file_prints_yaml_that_reads_back_the_same():
+    path = WS / "turtle_tf/launch/turtle_tf_demo.launch"
+    proc = run_cli("convert", str(path), "--to", "yaml")
+    assert proc.returncode == 0, proc.stderr
+    assert shape(yaml_frontend.parse_string(proc.stdout, "x.yaml")) == \
+        shape(xml_frontend.parse_file(str(path)))
+
+
+def test_cli_convert_writes_output_file(tmp_path):
+    src = tmp_path / "a.launch.yaml"
+    src.write_text("launch:\n  - arg: {name: a, default: 1}\n")
+    out = tmp_path / "a.launch"
+    proc = run_cli("convert", str(src), "--to", "xml", "-o", str(out))
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout == ""
+    assert xml_frontend.parse_file(str(out)).children[0].attributes == {"name": "a",
+                                                                        "default": "1"}
+
+
+def test_cli_convert_bad_input_is_one_located_error_line(tmp_path):
+    src = tmp_path / "bad.launch.yaml"
+    src.write_text("launch:\n  - node: {pkg: p\n")
+    proc = run_cli("convert", str(src), "--to", "xml")
+    assert proc.returncode == 2
+    assert "Traceback" not in proc.stderr
+    assert f"{src}:" in proc.stderr and "invalid YAML" in proc.stderr
+
+
+def test_cli_convert_directory_rewrites_includes_of_converted_files(tmp_path):
+    pkg = tmp_path / "pkg" / "launch"
+    pkg.mkdir(parents=True)
+    (pkg / "top.launch").write_text(
+        '<launch>\n  <include file="$(dirname)/inner.launch"/>\n'
+        '  <include file="$(find other)/launch/outside.launch"/>\n</launch>\n')
+    (pkg / "inner.launch").write_text('<launch><arg name="x" default="1"/></launch>\n')
+    (tmp_path / "pkg" / "package.xml").write_text("<package><name>pkg</name></package>\n")
+    proc = run_cli("convert", str(tmp_path / "pkg"), "--to", "yaml")
+    assert proc.returncode == 0, proc.stderr
+    top = yaml_frontend.parse_file(str(pkg / "top.launch.yaml"))
+    assert [c.get("file") for c in top.children] == [
+        "$(dirname)/inner.launch.yaml",               # converted in the same run
+        "$(find other)/launch/outside.launch"]        # not ours: left as written
+    assert (pkg / "inner.launch.yaml").is_file()
+    assert not (tmp_path / "pkg" / "package.xml.yaml").exists()
+    assert (pkg / "top.launch").is_file()  # sources are kept
+
+
+def test_directory_conversion_writes_nothing_when_one_file_is_bad(tmp_path):
+    (tmp_path / "a.launch").write_text("<launch/>\n")
+    (tmp_path / "b.launch").write_text("<launch>\n")
+    with pytest.raises(OrchestraError):
+        convert.convert_tree(str(tmp_path), "yaml")
+    assert sorted(os.listdir(tmp_path)) == ["a.launch", "b.launch"]
+
+
+def test_target_names_pair_up():
+    assert convert.target_name("d/x.launch", "yaml") == "d/x.launch.yaml"
+    assert convert.target_name("d/x.launch.xml", "yaml") == "d/x.launch.yaml"
+    assert convert.target_name("d/x.launch.yaml", "xml") == "d/x.launch"
+    assert convert.target_name("d/x.yml", "xml") == "d/x.launch"
