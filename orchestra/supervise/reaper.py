@@ -1,0 +1,160 @@
+"""Making sure no node outlives orchestra: process groups, parent-death signal, watchdog.
+
+Each node runs in its own session (like roslaunch), so a Ctrl-C on the terminal reaches only
+orchestra, which then stops nodes in order. The price roslaunch pays for that is orphans when
+it is SIGKILLed; orchestra closes the gap twice:
+
+- every child asks the kernel for SIGKILL when orchestra dies (``PR_SET_PDEATHSIG``, set in
+  the child between fork and exec);
+- a tiny forked watchdog process holds the read end of a pipe and learns each node's process
+  group; when the pipe closes without a goodbye (orchestra died), it SIGKILLs every group, so
+  grandchildren a node forked die too.
+"""
+from __future__ import annotations
+
+import ctypes
+import errno
+import logging
+import os
+import signal
+from typing import Callable, Iterable
+
+import psutil
+
+logger = logging.getLogger(__name__)
+
+PR_SET_PDEATHSIG = 1
+
+try:
+    _libc = ctypes.CDLL(None, use_errno=True)
+    _prctl = _libc.prctl
+except (OSError, AttributeError):  # not Linux: the watchdog alone covers it
+    _prctl = None
+
+
+def child_setup(parent_pid: int) -> Callable[[], None]:
+    """A ``preexec_fn`` that ties the child's life to ``parent_pid`` (runs in the child)."""
+
+    def setup() -> None:
+        if _prctl is not None:
+            _prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+        if os.getppid() != parent_pid:   # the parent died before prctl took effect
+            os._exit(127)
+
+    return setup
+
+
+def signal_group(pgid: int, sig: int, extra: Iterable[int] = ()) -> None:
+    """Send ``sig`` to a process group and to stray descendants that left it; ignore the gone."""
+    try:
+        os.killpg(pgid, sig)
+    except (ProcessLookupError, PermissionError):
+        pass
+    for pid in extra:
+        try:
+            os.kill(pid, sig)
+        except (ProcessLookupError, PermissionError):
+            pass
+
+
+def descendants(roots: Iterable[int]) -> dict[int, list[int]]:
+    """For each root pid, all its live descendants (one pass over the process table)."""
+    children: dict[int, list[int]] = {}
+    for proc in psutil.process_iter(["ppid"]):
+        ppid = proc.info.get("ppid")
+        if ppid is not None:
+            children.setdefault(ppid, []).append(proc.pid)
+    result: dict[int, list[int]] = {}
+    for root in roots:
+        found: list[int] = []
+        stack = list(children.get(root, ()))
+        while stack:
+            pid = stack.pop()
+            found.append(pid)
+            stack.extend(children.get(pid, ()))
+        result[root] = found
+    return result
+
+
+class Watchdog:
+    """A forked helper that SIGKILLs every registered process group if orchestra dies.
+
+    Fork it before starting threads or opening server sockets: the child closes every other
+    descriptor and touches nothing but the pipe and ``kill``.
+    """
+
+    def __init__(self) -> None:
+        read_fd, write_fd = os.pipe()
+        pid = os.fork()
+        if pid == 0:  # child
+            try:
+                os.close(write_fd)
+                _watchdog_main(read_fd)
+            finally:
+                os._exit(0)
+        os.close(read_fd)
+        self.pid = pid
+        self._fd: int | None = write_fd
+        os.set_inheritable(write_fd, False)
+
+    def _send(self, text: str) -> None:
+        if self._fd is None:
+            return
+        try:
+            os.write(self._fd, text.encode())
+        except OSError as exc:
+            logger.warning("watchdog unreachable: %s", exc)
+
+    def watch(self, pgid: int) -> None:
+        self._send(f"+{pgid}\n")
+
+    def forget(self, pgid: int) -> None:
+        self._send(f"-{pgid}\n")
+
+    def close(self) -> None:
+        """Clean exit: tell the watchdog there is nothing to kill, and reap it."""
+        if self._fd is None:
+            return
+        self._send("bye\n")
+        os.close(self._fd)
+        self._fd = None
+        try:
+            os.waitpid(self.pid, 0)
+        except ChildProcessError:
+            pass
+
+
+def _watchdog_main(read_fd: int) -> None:
+    for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP, signal.SIGPIPE):
+        signal.signal(sig, signal.SIG_IGN)
+    os.closerange(3, read_fd)
+    os.closerange(read_fd + 1, 65536)
+    groups: set[int] = set()
+    buf = b""
+    clean = False
+    while True:
+        try:
+            chunk = os.read(read_fd, 4096)
+        except InterruptedError:
+            continue
+        except OSError:
+            break
+        if not chunk:
+            break
+        buf += chunk
+        *lines, buf = buf.split(b"\n")
+        for line in lines:
+            if line == b"bye":
+                clean = True
+            elif line[:1] == b"+":
+                groups.add(int(line[1:]))
+            elif line[:1] == b"-":
+                groups.discard(int(line[1:]))
+    if clean:
+        return
+    for pgid in groups:
+        try:
+            os.killpg(pgid, signal.SIGKILL)
+        except OSError as exc:
+            if exc.errno not in (errno.ESRCH, errno.EPERM):
+                raise

@@ -1,0 +1,373 @@
+"""The Supervisor: starts ProcessSpecs, reacts to every child exit at once, stops them all.
+
+Takes plain ProcessSpecs (no launch plan, no master), so it is tested and benchmarked on its
+own. One event loop (``loop.py``) watches, per child, a pidfd (exit) and two pipes (output);
+plus the signal wake-up pipe and the status socket. Nothing polls.
+
+Exit code of a run: 0 when stopped on request or when every node ended by itself; 1 when a
+required node died or failed to start, or when any node ended FAILED (the message says which).
+"""
+from __future__ import annotations
+
+import logging
+import os
+import signal
+import subprocess
+import threading
+import time
+from dataclasses import dataclass, field
+from typing import Callable, Sequence
+
+import psutil
+
+from orchestra.supervise.loop import EventLoop, Timer
+from orchestra.supervise.output import NodeOutput, Screen
+from orchestra.supervise.process import (TERMINAL, ManagedProcess, ProcessSpec, RestartPolicy,
+                                         State, describe_exit, restart_delay)
+from orchestra.supervise.reaper import Watchdog, child_setup, descendants, signal_group
+
+logger = logging.getLogger(__name__)
+
+_STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+
+
+@dataclass
+class RunResult:
+    exit_code: int
+    reason: str = ""
+    failed: list[str] = field(default_factory=list)
+
+
+@dataclass
+class _Child:
+    """OS handles of one running instance of a process."""
+
+    popen: subprocess.Popen
+    pidfd: int
+    ps: psutil.Process | None = None
+    extra: list[int] = field(default_factory=list)   # descendants outside the process group
+
+
+class Supervisor:
+    """Runs a fixed set of processes until stopped, until all ended, or until a required one died."""
+
+    def __init__(self, specs: Sequence[ProcessSpec], policy: RestartPolicy | None = None,
+                 screen: Screen | None = None, log_dir: str | None = None,
+                 watchdog: Watchdog | None = None, log_max_bytes: int = 0,
+                 log_backups: int = 5, on_change: Callable[[], None] | None = None):
+        names = [s.name for s in specs]
+        if len(set(names)) != len(names):
+            raise ValueError("process names must be unique")
+        self.policy = policy or RestartPolicy()
+        self.screen = screen or Screen()
+        self.log_dir = log_dir
+        self.watchdog = watchdog
+        self.on_change = on_change
+        self.loop = EventLoop()
+        self.procs = [ManagedProcess(spec, start_index=i) for i, spec in enumerate(specs)]
+        self.outputs = {
+            p.spec.name: NodeOutput(p.spec.name, p.spec.output, self.screen, log_dir,
+                                    p.spec.log_name, log_max_bytes, log_backups)
+            for p in self.procs}
+        self._children: dict[str, _Child] = {}
+        self._timers: dict[str, Timer] = {}
+        self._open_pipes = 0
+        self.stopping = False
+        self.result: RunResult | None = None
+        self._stop_reason = ""
+        self._signal_count = 0
+        self._pid = os.getpid()
+        self.started_at = time.monotonic()
+
+    # ------------------------------------------------------------------ public API
+
+    def by_name(self, name: str) -> ManagedProcess:
+        for proc in self.procs:
+            if proc.spec.name == name:
+                return proc
+        raise KeyError(name)
+
+    def start_all(self) -> None:
+        """Spawn every process in order; a required one failing to spawn stops everything."""
+        for proc in self.procs:
+            if self.stopping:
+                break
+            self._spawn(proc)
+
+    def request_stop(self, reason: str = "stop requested", exit_code: int = 0) -> None:
+        """Begin the orderly stop of everything (idempotent; the first reason is kept)."""
+        if self.result is None:
+            self.result = RunResult(exit_code, reason)
+        if self.stopping:
+            return
+        self.stopping = True
+        self._stop_reason = reason
+        logger.info("stopping all processes: %s", reason)
+        running = [p for p in self.procs if p.state in (State.RUNNING, State.STARTING)
+                   and p.spec.name in self._children]
+        for proc in self.procs:
+            if proc.state == State.BACKOFF:
+                self._cancel_timer(proc)
+                proc.transition(State.EXITED, "stopped while waiting to respawn")
+            elif proc.state == State.STARTING and proc.spec.name not in self._children:
+                proc.transition(State.EXITED, "never started")
+        trees = descendants(self._children[p.spec.name].popen.pid for p in running)
+        for proc in sorted(running, key=lambda p: p.start_index, reverse=True):
+            child = self._children[proc.spec.name]
+            pid = child.popen.pid
+            child.extra = [d for d in trees.get(pid, ()) if _pgid(d) != pid]
+            proc.transition(State.STOPPING, reason)
+            signal_group(pid, signal.SIGINT, child.extra)
+            self._set_timer(proc, proc.spec.sigint_timeout,
+                            lambda p=proc: self._escalate(p, signal.SIGTERM))
+        self._changed()
+
+    def kill_all(self) -> None:
+        """Second Ctrl-C: no more waiting, SIGKILL every process still stopping."""
+        for proc in self.procs:
+            if proc.state == State.STOPPING:
+                self._escalate(proc, signal.SIGKILL)
+
+    def done(self) -> bool:
+        return all(p.state in TERMINAL for p in self.procs)
+
+    def run(self, install_signals: bool = True) -> RunResult:
+        """Start everything and supervise until the run ends; returns the outcome."""
+        restore = self._install_signals() if install_signals else None
+        try:
+            self.start_all()
+            while not self.done():
+                self.loop.run_once()
+            # collect what the last exits left in the pipes (bounded: grandchildren may hold them)
+            deadline = time.monotonic() + 1.0
+            while self._open_pipes and time.monotonic() < deadline:
+                self.loop.run_once(limit=max(0.0, deadline - time.monotonic()))
+        finally:
+            if restore is not None:
+                restore()
+            self._close()
+        return self._finish()
+
+    # ------------------------------------------------------------------ spawning
+
+    def _spawn(self, proc: ManagedProcess) -> None:
+        spec = proc.spec
+        if proc.state == State.BACKOFF:
+            proc.transition(State.STARTING, "respawn")
+        try:
+            os.makedirs(spec.cwd, exist_ok=True)
+            popen = subprocess.Popen(
+                list(spec.argv), cwd=spec.cwd, env=dict(spec.env), stdin=subprocess.DEVNULL,
+                stdout=subprocess.PIPE, stderr=subprocess.PIPE, close_fds=True,
+                start_new_session=True, preexec_fn=child_setup(self._pid))
+        except (OSError, subprocess.SubprocessError) as exc:
+            self._spawn_failed(proc, exc)
+            return
+        pidfd = os.pidfd_open(popen.pid)
+        child = _Child(popen, pidfd)
+        self._children[spec.name] = child
+        if self.watchdog is not None:
+            self.watchdog.watch(popen.pid)
+        self.loop.add_reader(pidfd, lambda: self._on_exit(proc))
+        output = self.outputs[spec.name]
+        for stream, pipe in (("out", popen.stdout), ("err", popen.stderr)):
+            fd = pipe.fileno()
+            os.set_blocking(fd, False)
+            self._open_pipes += 1
+            self.loop.add_reader(fd, lambda fd=fd, s=stream, p=pipe: self._on_output(fd, s, p, output))
+        proc.pid = popen.pid
+        proc.started_at = time.monotonic()
+        proc.exit_code = None
+        proc.transition(State.RUNNING, f"pid {popen.pid}")
+        self.screen.message(f"process[{spec.name}]: started with pid [{popen.pid}]")
+        self._changed()
+
+    def _spawn_failed(self, proc: ManagedProcess, exc: BaseException) -> None:
+        spec = proc.spec
+        what = f"cannot start {spec.name} ({' '.join(spec.argv)}): {_oserror_text(exc)}"
+        if spec.location:
+            what = f"{spec.location}: {what}"
+        proc.transition(State.FAILED, what)
+        self.screen.message(f"orchestra: error: {what}", err=True)
+        if spec.required:
+            self.request_stop(f"required process {spec.name} failed to start", exit_code=1)
+        self._changed()
+
+    # ------------------------------------------------------------------ events
+
+    def _on_output(self, fd: int, stream: str, pipe, output: NodeOutput) -> None:
+        while True:
+            try:
+                data = os.read(fd, 65536)
+            except BlockingIOError:
+                return
+            except OSError:
+                data = b""
+            if not data:
+                self.loop.remove_reader(fd)
+                pipe.close()
+                self._open_pipes -= 1
+                output.end(stream)
+                return
+            output.feed(stream, data)
+
+    def _drain(self, child: _Child, output: NodeOutput) -> None:
+        """Read everything the dead child left in its pipes, so no last line is lost."""
+        for stream, pipe in (("out", child.popen.stdout), ("err", child.popen.stderr)):
+            if pipe is not None and not pipe.closed:
+                self._on_output(pipe.fileno(), stream, pipe, output)
+
+    def _on_exit(self, proc: ManagedProcess) -> None:
+        spec = proc.spec
+        child = self._children.pop(spec.name)
+        self.loop.remove_reader(child.pidfd)
+        os.close(child.pidfd)
+        code = child.popen.wait()
+        # whatever the node left behind in its group (and strays seen at stop) goes with it
+        signal_group(child.popen.pid, signal.SIGKILL, child.extra)
+        if self.watchdog is not None:
+            self.watchdog.forget(child.popen.pid)
+        self._drain(child, self.outputs[spec.name])
+        self._cancel_timer(proc)
+        proc.exit_code = code
+        uptime = time.monotonic() - (proc.started_at or time.monotonic())
+        if proc.state == State.STOPPING or self.stopping:
+            proc.transition(State.EXITED, f"stopped ({describe_exit(code)})")
+            self._changed()
+            return
+        described = describe_exit(code)
+        if spec.required:
+            proc.transition(State.EXITED, f"required process died ({described})")
+            self.screen.message(
+                f"orchestra: required process [{spec.name}] has died ({described}); "
+                "shutting down", err=True)
+            self.request_stop(f"required process {spec.name} died ({described})", exit_code=1)
+            return
+        if not spec.respawn:
+            proc.transition(State.EXITED, described)
+            text = ("has finished cleanly" if code == 0
+                    else f"has died [pid {child.popen.pid}, {described}]")
+            self.screen.message(f"process[{spec.name}]: {text}", err=code != 0)
+            self._changed()
+            return
+        proc.short_runs = 1 if uptime >= self.policy.stable_after else proc.short_runs + 1
+        delay = restart_delay(self.policy, spec.respawn_delay, proc.short_runs)
+        if delay is None:
+            proc.transition(State.FAILED, f"crash loop: {proc.short_runs} short runs in a row, "
+                                          f"last {described}")
+            self.screen.message(f"orchestra: {spec.name} keeps dying ({described}); "
+                                f"gave up after {proc.restarts} restarts", err=True)
+            self._changed()
+            return
+        proc.transition(State.BACKOFF, f"{described}; respawn in {delay:.3g} s")
+        self.screen.message(f"process[{spec.name}]: died ({described}), respawning"
+                            + (f" in {delay:.3g} s" if delay > 0 else ""), err=True)
+        proc.restarts += 1
+        if delay <= 0:
+            self._spawn(proc)
+        else:
+            self._set_timer(proc, delay, lambda: self._spawn(proc))
+        self._changed()
+
+    def _escalate(self, proc: ManagedProcess, sig: int) -> None:
+        child = self._children.get(proc.spec.name)
+        if child is None or proc.state != State.STOPPING:
+            return
+        logger.warning("%s did not stop in time: sending %s", proc.spec.name,
+                       signal.Signals(sig).name)
+        signal_group(child.popen.pid, sig, child.extra)
+        if sig == signal.SIGTERM:
+            self._set_timer(proc, proc.spec.sigterm_timeout,
+                            lambda: self._escalate(proc, signal.SIGKILL))
+        else:
+            self._cancel_timer(proc)
+
+    # ------------------------------------------------------------------ helpers
+
+    def _set_timer(self, proc: ManagedProcess, delay: float, callback: Callable[[], None]) -> None:
+        self._cancel_timer(proc)
+        self._timers[proc.spec.name] = self.loop.call_later(delay, callback)
+
+    def _cancel_timer(self, proc: ManagedProcess) -> None:
+        timer = self._timers.pop(proc.spec.name, None)
+        if timer is not None:
+            timer.cancel()
+
+    def _changed(self) -> None:
+        if self.on_change is not None:
+            self.on_change()
+
+    def _install_signals(self) -> Callable[[], None] | None:
+        """SIGINT/SIGTERM/SIGHUP -> orderly stop; a second one -> SIGKILL what is left."""
+        if threading.current_thread() is not threading.main_thread():
+            return None
+        read_fd, write_fd = os.pipe()
+        os.set_blocking(read_fd, False)
+        os.set_blocking(write_fd, False)
+        old_wakeup = signal.set_wakeup_fd(write_fd, warn_on_full_buffer=False)
+        old_handlers = {sig: signal.signal(sig, lambda *_: None) for sig in _STOP_SIGNALS}
+
+        def on_signal() -> None:
+            try:
+                data = os.read(read_fd, 64)
+            except BlockingIOError:
+                return
+            for signum in data:
+                if signum not in _STOP_SIGNALS:
+                    continue
+                self._signal_count += 1
+                name = signal.Signals(signum).name
+                if self._signal_count == 1:
+                    self.screen.message(f"orchestra: {name} received, stopping all nodes",
+                                        err=True)
+                    self.request_stop(f"{name} received")
+                else:
+                    self.screen.message(f"orchestra: {name} again, killing all nodes", err=True)
+                    self.kill_all()
+
+        self.loop.add_reader(read_fd, on_signal)
+
+        def restore() -> None:
+            signal.set_wakeup_fd(old_wakeup)
+            for sig, handler in old_handlers.items():
+                signal.signal(sig, handler)
+            self.loop.remove_reader(read_fd)
+            os.close(read_fd)
+            os.close(write_fd)
+
+        return restore
+
+    def _close(self) -> None:
+        for output in self.outputs.values():
+            output.close()
+        for child in self._children.values():  # only after an internal error
+            signal_group(child.popen.pid, signal.SIGKILL, child.extra)
+            child.popen.wait()
+            os.close(child.pidfd)
+        self._children.clear()
+        self.loop.close()
+
+    def _finish(self) -> RunResult:
+        failed = [p.spec.name for p in self.procs if p.state == State.FAILED]
+        result = self.result or RunResult(0, "all processes ended")
+        result.failed = failed
+        if failed and result.exit_code == 0:
+            result.exit_code = 1
+            result.reason = result.reason + "; failed: " + ", ".join(failed)
+        return result
+
+
+def _pgid(pid: int) -> int | None:
+    try:
+        return os.getpgid(pid)
+    except OSError:
+        return None
+
+
+def _oserror_text(exc: BaseException) -> str:
+    if isinstance(exc, OSError) and exc.strerror:
+        text = exc.strerror
+        if exc.errno == 8:
+            text += " (a script needs a '#!' line)"
+        return text
+    return str(exc)
