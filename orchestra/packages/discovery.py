@@ -45,20 +45,28 @@ def _normal(path: str) -> str:
 
 
 def catkin_workspace(cwd: str) -> str | None:
-    """The catkin workspace containing ``cwd`` (the nearest ancestor with a workspace marker).
+    """The catkin workspace containing ``cwd``.
 
-    A bare ``src/`` is not enough: ``~/src`` is common and crawling a home directory's sources
-    on every launch would be slow and surprising.
+    The nearest ancestor whose ``src/`` sits next to a workspace marker wins; without any
+    marker (a workspace made by hand, no ROS installed), standing inside a directory named
+    ``src`` makes its parent the workspace, so ``mkdir -p ws/src && cd ws/src &&
+    orchestra create-pkg demo`` is usable at once. A ``src/`` that is merely *below* an
+    ancestor is not enough: ``~/src`` is common and crawling it from anywhere in the home
+    directory would be slow and surprising.
     """
-    directory = _normal(cwd)
+    start = _normal(cwd)
+    directory = start
+    fallback = None
     while True:
         if os.path.isdir(os.path.join(directory, "src")):
             for marker in WORKSPACE_MARKERS:
                 if os.path.exists(os.path.join(directory, marker)):
                     return directory
         parent = os.path.dirname(directory)
+        if fallback is None and os.path.basename(directory) == "src" and parent != directory:
+            fallback = parent
         if parent == directory:
-            return None
+            return fallback
         directory = parent
 
 
