@@ -72,13 +72,24 @@ class RotatingFile:
             os.unlink(self.path)
 
     def write(self, data: bytes) -> None:
-        fh = self._open()
-        if self.max_bytes and self._size and self._size + len(data) > self.max_bytes:
-            self._rotate()
+        """Append ``data``; when it would pass ``max_bytes``, rotate at a line boundary."""
+        while data:
             fh = self._open()
-        fh.write(data)
-        fh.flush()
-        self._size += len(data)
+            chunk = data
+            if self.max_bytes and self._size + len(data) > self.max_bytes:
+                room = self.max_bytes - self._size
+                cut = data.rfind(b"\n", 0, room) + 1 if room > 0 else 0
+                if cut == 0 and self._size == 0:
+                    cut = max(room, 1)      # one line longer than the limit: split it
+                if cut == 0:
+                    self._rotate()
+                    continue
+                chunk = data[:cut]
+            fh.write(chunk)
+            self._size += len(chunk)
+            data = data[len(chunk):]
+        if self._fh is not None:
+            self._fh.flush()
 
     def close(self) -> None:
         if self._fh is not None:
