@@ -48,7 +48,7 @@ class MasterHandle:
         self.shutdown_reason: str | None = None
         self._stopped = threading.Event()
         self._lock = threading.Lock()
-        self._thread = threading.Thread(target=server.serve_forever, kwargs={"poll_interval": 0.2},
+        self._thread = threading.Thread(target=server.serve_forever, kwargs={"poll_interval": 0.1},
                                         name=f"master :{self.port}", daemon=True)
 
     def _start(self) -> None:
