@@ -1,0 +1,706 @@
+"""The launch interpreter: Entity trees in, one immutable ``LaunchPlan`` out.
+
+It applies roslaunch's tag rules (``launch``, ``node``, ``test``, ``machine``, ``include``,
+``group``, ``remap``, ``env``, ``param``, ``rosparam``, ``arg``) with their attribute rules,
+``if``/``unless`` on every tag, arg scoping and remap/env/namespace inheritance (see
+``context.py``). Both front ends (XML and YAML) produce Entities, so the rules live here once.
+
+Every user mistake raises ``LaunchError`` naming the file, line, tag and attribute. The only
+side effects are reading the files the launch file names and, for ``<param command=...>``,
+running that command at load time as roslaunch does (unless ``no_exec``).
+"""
+from __future__ import annotations
+
+import base64
+import logging
+import os
+import shlex
+import subprocess
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+from orchestra.errors import Location, OrchestraError
+from orchestra.launch.context import Scope, ScopeError
+from orchestra.launch.entity import Entity
+from orchestra.launch.plan import LaunchPlan, Machine, Node, Test
+from orchestra.launch.substitution import ArgNotSet, SubstitutionError, resolve
+from orchestra.launch.values import bool_attribute, convert_value, float_attribute
+from orchestra.names import (canonicalize, is_legal_name, is_private, make_global_ns,
+                             ns_join)
+
+log = logging.getLogger(__name__)
+
+ROSLAUNCH_VERSION = "1.16.0"
+DEFAULT_TIMEOUT = 10.0
+TEST_TIME_LIMIT = 60.0
+
+NODE_ATTRS = {"pkg", "type", "machine", "name", "args", "output", "respawn", "respawn_delay",
+              "cwd", "ns", "clear_params", "launch-prefix", "required"}
+TEST_ATTRS = NODE_ATTRS | {"test-name", "time-limit", "retry"}
+MACHINE_ATTRS = {"name", "address", "env-loader", "ssh-port", "user", "password", "default",
+                 "timeout"}
+PARAM_ATTRS = {"name", "value", "type", "textfile", "binfile", "command"}
+ROSPARAM_ATTRS = {"command", "ns", "file", "param", "subst_value"}
+ARG_ATTRS = {"name", "value", "default", "doc"}
+INCLUDE_ATTRS = {"file", "ns", "clear_params", "pass_all_args"}
+GROUP_ATTRS = {"ns", "clear_params"}
+REMAP_ATTRS = {"from", "to"}
+ENV_ATTRS = {"name", "value"}
+
+
+class LaunchError(OrchestraError):
+    """A launch file roslaunch would reject (or that orchestra refuses for safety)."""
+
+
+class Binary(bytes):
+    """A ``binfile`` / ``!!binary`` value (bytes; XML-RPC base64 on the wire)."""
+
+
+@dataclass(frozen=True)
+class ArgInfo:
+    """A top-level ``<arg>`` as ``--ros-args`` reports it."""
+
+    name: str
+    doc: str | None
+    default: str | None
+
+
+@dataclass
+class LoadOptions:
+    """How to load: command-line args, whether ``command=`` params run, roscore params."""
+
+    args: dict[str, str] = field(default_factory=dict)
+    no_exec: bool = False
+    roscore: bool = False
+    ros_namespace: str | None = None
+
+
+def _is_yaml(path: str) -> bool:
+    return path.lower().endswith((".yaml", ".yml"))
+
+
+def parse_launch_file(path: str) -> Entity:
+    """The Entity tree of a launch file, XML or YAML by extension."""
+    if _is_yaml(path):
+        from orchestra.launch import yaml as yaml_front
+        return yaml_front.parse_file(path)
+    from orchestra.launch import xml as xml_front
+    return xml_front.parse_file(path)
+
+
+class Interpreter:
+    """Builds one plan; use ``load_file``/``load_entity`` once, then ``plan()``."""
+
+    def __init__(self, options: LoadOptions | None = None):
+        self.options = options or LoadOptions()
+        self.params: dict[str, Any] = {}
+        self.clear_params: list[str] = []
+        self.nodes: list[Node] = []
+        self.tests: list[Test] = []
+        self.machines: dict[str, Machine] = {"": Machine(name="")}
+        self.files: list[str] = []
+        self.warnings: list[str] = []
+        self.root_args: list[ArgInfo] = []
+        self._node_names: dict[str, Location] = {}
+        self._parse: Callable[[str], Entity] = parse_launch_file
+
+    # ================================================================ entry points
+    def load_file(self, path: str) -> None:
+        root = self._parse(path)
+        self.load_entity(root, path)
+
+    def load_entity(self, root: Entity, filename: str) -> None:
+        """Interpret a parsed root ``<launch>`` entity read from ``filename``."""
+        if self.options.roscore and not self.files:
+            self._roscore()
+        self.files.append(filename)
+        ns = self.options.ros_namespace
+        if ns is None:
+            ns = os.environ.get("ROS_NAMESPACE", "/") or "/"
+        scope = Scope(ns, filename, include_stack=(os.path.abspath(filename),))
+        scope.args = dict(self.options.args)
+        self._check_launch_tag(root, scope)
+        self._children(root.children, scope, None)
+        for name in scope.arg_names:
+            doc, default = scope.arg_docs.get(name, (None, None))
+            if name in scope.arg_docs:
+                self.root_args.append(ArgInfo(name, doc, default))
+
+    def plan(self) -> LaunchPlan:
+        return LaunchPlan(params=self.params, clear_params=tuple(self.clear_params),
+                          nodes=tuple(self.nodes), tests=tuple(self.tests),
+                          machines=self.machines, files_loaded=tuple(self.files))
+
+    # ================================================================ helpers
+    def _error(self, entity: Entity, message: str, attr: str | None = None) -> LaunchError:
+        where = f"<{entity.tag}>" + (f" attribute '{attr}'" if attr else "")
+        return LaunchError(f"{where}: {message}", entity.location)
+
+    def _warn(self, entity: Entity, message: str) -> None:
+        text = f"{entity.location}: {message}"
+        self.warnings.append(text)
+        log.warning(text)
+
+    def _resolve(self, entity: Entity, attr: str, scope: Scope, raw: str | None = None
+                 ) -> str | None:
+        value = entity.attributes.get(attr) if raw is None else raw
+        if value is None or "$" not in value:
+            return value
+        try:
+            return resolve(value, scope)
+        except ArgNotSet as exc:
+            raise self._error(entity, f"arg '{exc.name}' is not set here (declare it with "
+                              "<arg> or pass it as name:=value)", attr) from None
+        except OrchestraError as exc:
+            if exc.location is not None and exc.location.line is not None:
+                raise
+            raise self._error(entity, exc.message, attr) from None
+
+    def _opt(self, entity: Entity, scope: Scope, *attrs: str) -> list[str | None]:
+        return [self._resolve(entity, a, scope) for a in attrs]
+
+    def _req(self, entity: Entity, scope: Scope, *attrs: str) -> list[str]:
+        for a in attrs:
+            if a not in entity.attributes:
+                raise self._error(entity, f"missing required attribute '{a}'")
+        return [self._resolve(entity, a, scope) or "" for a in attrs]
+
+    def _check_attrs(self, entity: Entity, allowed: set[str]) -> None:
+        for attr in entity.attributes:
+            if attr not in allowed and attr not in ("if", "unless"):
+                self._warn(entity, f"unknown <{entity.tag}> attribute '{attr}'")
+
+    def _enabled(self, entity: Entity, scope: Scope) -> bool:
+        """roslaunch's if/unless: both is an error; values must be true/false/1/0."""
+        has_if, has_unless = "if" in entity.attributes, "unless" in entity.attributes
+        if not has_if and not has_unless:
+            return True
+        if has_if and has_unless:
+            raise self._error(entity, "cannot set both 'if' and 'unless' on the same tag")
+        attr = "if" if has_if else "unless"
+        value = self._resolve(entity, attr, scope) or ""
+        try:
+            flag = convert_value(value, "bool")
+        except ValueError as exc:
+            raise self._error(entity, str(exc), attr) from None
+        return flag if has_if else not flag
+
+    def _set_param(self, name: str, value: Any) -> None:
+        key = canonicalize(name)
+        self.params[key] = value
+
+    # ================================================================ tags
+    def _check_launch_tag(self, entity: Entity, scope: Scope) -> None:
+        if entity.tag != "launch":
+            raise self._error(entity, "the root element must be <launch>")
+        if self._enabled(entity, scope):
+            deprecated = entity.attributes.get("deprecated")
+            if deprecated:
+                self._warn(entity, f"DEPRECATED: {deprecated}")
+
+    def _children(self, children: list[Entity], scope: Scope,
+                  default_machine: Machine | None) -> Machine | None:
+        for entity in children:
+            tag = entity.tag
+            handler = _TAGS.get(tag)
+            if handler is None:
+                self._warn(entity, f"unrecognized tag <{tag}>")
+                continue
+            result = handler(self, entity, scope, default_machine)
+            if tag in ("group", "include", "machine") and result is not None:
+                default_machine = result
+        return default_machine
+
+    def _ns_and_clear_params(self, entity: Entity, scope: Scope, node_name: str | None = None,
+                             include_file: str | None = None) -> Scope:
+        ns = None
+        if "ns" in entity.attributes:
+            ns = self._resolve(entity, "ns", scope)
+            if not ns:
+                raise self._error(entity, "empty namespace", "ns")
+        if include_file is not None:
+            child = scope.include_child(ns, include_file)
+        else:
+            child = scope.child(ns)
+        clear = self._resolve(entity, "clear_params", scope)
+        if clear:
+            try:
+                clear_flag = bool_attribute(clear, False, "clear_params")
+            except ValueError as exc:
+                raise self._error(entity, str(exc), "clear_params") from None
+            if clear_flag:
+                if entity.tag in ("node", "test"):
+                    if not node_name:
+                        raise self._error(entity, "'name' must be set to use clear_params",
+                                          "clear_params")
+                    self.clear_params.append(make_global_ns(ns_join(child.ns, node_name)))
+                else:
+                    if not ns:
+                        raise self._error(entity, "'ns' must be set to use clear_params",
+                                          "clear_params")
+                    self.clear_params.append(child.ns)
+        return child
+
+    def _group(self, entity: Entity, scope: Scope, default_machine: Machine | None
+               ) -> Machine | None:
+        if not self._enabled(entity, scope):
+            return None
+        self._check_attrs(entity, GROUP_ATTRS)
+        child = self._ns_and_clear_params(entity, scope)
+        child.params = list(child.params)
+        return self._children(entity.children, child, default_machine)
+
+    # ---------------------------------------------------------------- arg
+    def _arg(self, entity: Entity, scope: Scope, default_machine: Machine | None = None
+             ) -> None:
+        if not self._enabled(entity, scope):
+            return None
+        self._check_attrs(entity, ARG_ATTRS)
+        (name,) = self._req(entity, scope, "name")
+        value, default, doc = self._opt(entity, scope, "value", "default", "doc")
+        if value is not None and default is not None:
+            raise self._error(entity, "<arg> may have only one of value/default")
+        try:
+            scope.add_arg(name, default=default, value=value, doc=doc)
+        except ScopeError as exc:
+            raise self._error(entity, str(exc), "name") from None
+        return None
+
+    # ---------------------------------------------------------------- env
+    def _env(self, entity: Entity, scope: Scope, default_machine: Machine | None = None
+             ) -> None:
+        if not self._enabled(entity, scope):
+            return None
+        self._check_attrs(entity, ENV_ATTRS)
+        name, value = self._req(entity, scope, "name", "value")
+        if not name:
+            raise self._error(entity, "'name' must be non-empty", "name")
+        scope.env_args.append((name, value))
+        return None
+
+    # ---------------------------------------------------------------- remap
+    def _remap_pair(self, entity: Entity, scope: Scope) -> tuple[str, str] | None:
+        if not self._enabled(entity, scope):
+            return None
+        self._check_attrs(entity, REMAP_ATTRS)
+        src, dst = self._req(entity, scope, "from", "to")
+        return src, dst
+
+    def _add_remap(self, entity: Entity, target: Scope, pair: tuple[str, str]) -> None:
+        try:
+            target.add_remap(*pair)
+        except ScopeError as exc:
+            raise self._error(entity, str(exc)) from None
+
+    def _remap(self, entity: Entity, scope: Scope, default_machine: Machine | None = None
+               ) -> None:
+        pair = self._remap_pair(entity, scope)
+        if pair is not None:
+            self._add_remap(entity, scope, pair)
+        return None
+
+    # ---------------------------------------------------------------- machine
+    def _machine(self, entity: Entity, scope: Scope, default_machine: Machine | None = None
+                 ) -> Machine | None:
+        if not self._enabled(entity, scope):
+            return None
+        scope = scope.child(None)
+        legacy = self._opt(entity, scope, "ros-root", "ros-package-path", "ros-ip",
+                           "ros-hostname")
+        if any(legacy):
+            raise self._error(entity, "ros-* attributes are not supported since ROS Fuerte; "
+                              "use env-loader instead")
+        self._check_attrs(entity, MACHINE_ATTRS)
+        name, address = self._req(entity, scope, "name", "address")
+        env_loader, ssh_port, user, password, default, timeout = self._opt(
+            entity, scope, "env-loader", "ssh-port", "user", "password", "default", "timeout")
+        try:
+            port = int(ssh_port or "22")
+        except ValueError:
+            raise self._error(entity, f"not a port number: {ssh_port}", "ssh-port") from None
+        default = (default or "false").lower()
+        if default not in ("true", "false", "never"):
+            raise self._error(entity, f"invalid value: {default} (true, false or never)",
+                              "default")
+        for child in entity.children:
+            if child.tag == "env":
+                raise self._error(child, "<env> inside <machine> is not supported since ROS "
+                                  "Fuerte; use env-loader instead")
+            self._warn(child, f"unrecognized <{child.tag}> tag in <machine>")
+        timeout_value = DEFAULT_TIMEOUT
+        if timeout == "":
+            raise self._error(entity, "cannot be empty", "timeout")
+        if timeout is not None:
+            try:
+                timeout_value = float(timeout)
+            except ValueError:
+                raise self._error(entity, f"must be a number: [{timeout}]", "timeout") from None
+            if timeout_value <= 0:
+                raise self._error(entity, f"must be a positive number: [{timeout}]", "timeout")
+        if not env_loader:
+            distro = os.environ.get("ROS_DISTRO", "")
+            env_loader = f"/opt/ros/{distro}/env.sh" if distro else None
+        machine = Machine(name=name, address=address, env_loader=env_loader, ssh_port=port,
+                          user=user or None, password=password or None,
+                          timeout=timeout_value, assignable=default != "never")
+        existing = self.machines.get(name)
+        if existing is not None and existing != machine:
+            raise self._error(entity, f"machine [{name}] already defined differently", "name")
+        if existing is None:
+            self.machines[name] = machine
+        return machine if default == "true" else None
+
+    # ---------------------------------------------------------------- param
+    def _param(self, entity: Entity, scope: Scope, default_machine: Machine | None = None,
+               force_local: bool = False) -> None:
+        if not self._enabled(entity, scope):
+            return None
+        self._check_attrs(entity, PARAM_ATTRS)
+        ptype = (entity.attributes.get("type") or "auto").lower().strip()
+        sources = ("value", "textfile", "binfile", "command")
+        vals = self._opt(entity, scope, *sources)
+        given = [s for s, v in zip(sources, vals) if v is not None]
+        if len(given) != 1:
+            raise self._error(entity, "<param> must have exactly one of value/textfile/"
+                              f"binfile/command (has {', '.join(given) or 'none'})")
+        if "name" not in entity.attributes:
+            raise self._error(entity, "missing required attribute 'name'")
+        name = self._resolve(entity, "name", scope, entity.attributes["name"].strip()) or ""
+        value = self._param_value(entity, name, ptype, given[0], vals[sources.index(given[0])])
+        if is_private(name) or force_local:
+            scope.add_param(name, value)
+        else:
+            self._set_param(ns_join(scope.ns, name), value)
+        return None
+
+    def _param_value(self, entity: Entity, name: str, ptype: str, source: str, raw: str
+                     ) -> Any:
+        try:
+            if source == "value":
+                return convert_value(raw.strip(), ptype)
+            if source == "textfile":
+                try:
+                    with open(raw, "r", encoding="utf-8") as fh:
+                        text = fh.read()
+                except OSError as exc:
+                    raise self._error(entity, f"cannot read [{raw}]: {exc.strerror}",
+                                      "textfile") from None
+                return convert_value(text, ptype)
+            if source == "binfile":
+                try:
+                    with open(raw, "rb") as fh:
+                        return Binary(fh.read())
+                except OSError as exc:
+                    raise self._error(entity, f"cannot read [{raw}]: {exc.strerror}",
+                                      "binfile") from None
+            if self.options.no_exec:
+                return {"__command__": raw}
+            return convert_value(self._run_command(entity, name, raw), ptype)
+        except OrchestraError:
+            raise
+        except ValueError as exc:
+            raise self._error(entity, str(exc), "type" if ptype != "auto" else source) from None
+
+    def _run_command(self, entity: Entity, name: str, command: str) -> str:
+        """roslaunch runs ``command=`` at load time, shell-split but without a shell."""
+        try:
+            argv = shlex.split(command)
+        except ValueError as exc:
+            raise self._error(entity, f"cannot split command [{command}]: {exc}",
+                              "command") from None
+        if not argv:
+            raise self._error(entity, "empty command", "command")
+        try:
+            proc = subprocess.run(argv, stdout=subprocess.PIPE, stdin=subprocess.DEVNULL,
+                                  check=False)
+        except OSError as exc:
+            raise self._error(entity, f"cannot run [{command}]: {exc.strerror}",
+                              "command") from None
+        if proc.returncode != 0:
+            raise self._error(entity, f"command for param [{name}] failed with exit code "
+                              f"{proc.returncode}: [{command}]", "command")
+        return proc.stdout.decode("utf-8", "replace")
+
+    # ---------------------------------------------------------------- rosparam
+    def _rosparam(self, entity: Entity, scope: Scope, default_machine: Machine | None = None
+                  ) -> None:
+        if not self._enabled(entity, scope):
+            return None
+        self._check_attrs(entity, ROSPARAM_ATTRS)
+        cmd, ns, file_, param, subst = self._opt(entity, scope, "command", "ns", "file",
+                                                  "param", "subst_value")
+        try:
+            subst_value = bool_attribute(subst, False, "subst_value")
+        except ValueError as exc:
+            raise self._error(entity, str(exc), "subst_value") from None
+        param = ns_join(ns or "", param or "")
+        cmd = cmd or "load"
+        if cmd not in ("load", "dump", "delete"):
+            raise self._error(entity, f"must be 'load', 'dump' or 'delete' (not '{cmd}')",
+                              "command")
+        if file_ is not None:
+            if cmd == "load" and not os.path.isfile(file_):
+                raise self._error(entity, f"file does not exist [{file_}]", "file")
+            if cmd == "delete":
+                raise self._error(entity, "'file' is invalid with command='delete'", "file")
+        full = ns_join(scope.ns, param) if param else scope.ns
+        if cmd != "load":
+            log.debug("rosparam %s %s ignored while resolving", cmd, full)
+            return None
+        source = file_ or entity.location.file
+        if file_:
+            try:
+                with open(file_, "r", encoding="utf-8") as fh:
+                    text = fh.read()
+            except OSError as exc:
+                raise self._error(entity, f"cannot read [{file_}]: {exc.strerror}",
+                                  "file") from None
+        else:
+            text = entity.text or ""
+        if subst_value:
+            try:
+                text = resolve(text, scope) or ""
+            except ArgNotSet as exc:
+                raise self._error(entity, f"arg '{exc.name}' is not set here",
+                                  "subst_value") from None
+            except SubstitutionError as exc:
+                raise self._error(entity, exc.message, "subst_value") from None
+        from orchestra.params.yaml import RosparamYamlError, load_rosparam_yaml
+        try:
+            data = load_rosparam_yaml(text, source)
+        except RosparamYamlError as exc:
+            if file_:
+                raise
+            raise self._error(entity, f"inline YAML: {exc.message}") from None
+        if not param and not isinstance(data, dict):
+            raise self._error(entity, "'param' must be set for non-dictionary values", "param")
+        self._add_rosparam(entity, full, data)
+        return None
+
+    def _add_rosparam(self, entity: Entity, name: str, value: Any) -> None:
+        if name == "/" and not isinstance(value, dict):
+            raise self._error(entity, "cannot load a non-dictionary into the global namespace")
+        stack = [(name, value)]
+        while stack:
+            key, val = stack.pop()
+            if isinstance(val, dict):
+                for sub, subval in reversed(list(val.items())):
+                    stack.append((ns_join(key, str(sub)), subval))
+            else:
+                self._set_param(key, Binary(val) if isinstance(val, bytes) else val)
+
+    # ---------------------------------------------------------------- node / test
+    def _node(self, entity: Entity, scope: Scope, default_machine: Machine | None
+              ) -> None:
+        self._node_or_test(entity, scope, default_machine, is_test=False)
+        return None
+
+    def _test(self, entity: Entity, scope: Scope, default_machine: Machine | None
+              ) -> None:
+        self._node_or_test(entity, scope, default_machine, is_test=True)
+        return None
+
+    def _test_attrs(self, entity: Entity, scope: Scope) -> tuple[str, float, int]:
+        for attr in ("respawn", "respawn_delay", "output"):
+            if attr in entity.attributes:
+                raise self._error(entity, "<test> cannot have this attribute", attr)
+        (test_name,) = self._req(entity, scope, "test-name")
+        time_limit_raw = self._resolve(entity, "time-limit", scope) or ""
+        retry_raw = self._resolve(entity, "retry", scope) or ""
+        time_limit = TEST_TIME_LIMIT
+        if time_limit_raw:
+            try:
+                time_limit = float(time_limit_raw)
+            except ValueError:
+                raise self._error(entity, f"must be a number: [{time_limit_raw}]",
+                                  "time-limit") from None
+            if time_limit <= 0.0:
+                raise self._error(entity, "must be a positive number", "time-limit")
+        retry = 0
+        if retry_raw:
+            try:
+                retry = int(retry_raw)
+            except ValueError:
+                raise self._error(entity, f"must be a number: [{retry_raw}]", "retry") from None
+        return test_name, time_limit, retry
+
+    def _node_or_test(self, entity: Entity, scope: Scope, default_machine: Machine | None,
+                      is_test: bool) -> None:
+        if not self._enabled(entity, scope):
+            return
+        if is_test:
+            self._check_attrs(entity, TEST_ATTRS)
+            (name,) = self._opt(entity, scope, "name")
+            test_name, time_limit, retry = self._test_attrs(entity, scope)
+            if not name:
+                name = test_name
+        else:
+            self._check_attrs(entity, NODE_ATTRS)
+            (name,) = self._req(entity, scope, "name")
+        if not is_legal_name(name):
+            self._warn(entity, f"illegal node name '{name}'")
+        child = self._ns_and_clear_params(entity, scope, node_name=name)
+        param_scope = child.child(name)
+        param_scope.params = []
+        pkg, node_type = self._req(entity, scope, "pkg", "type")
+        machine, args, output, respawn, respawn_delay, cwd, launch_prefix, required = \
+            self._opt(entity, scope, "machine", "args", "output", "respawn", "respawn_delay",
+                      "cwd", "launch-prefix", "required")
+        if "machine" in entity.attributes and not (machine or "").strip():
+            raise self._error(entity, "must be non-empty", "machine")
+        if not machine and default_machine is not None:
+            machine = default_machine.name
+        try:
+            required_flag = bool_attribute(required, False, "required")
+            respawn_flag = bool_attribute(respawn, False, "respawn")
+            delay = float_attribute(respawn_delay, 0.0, "respawn_delay")
+        except ValueError as exc:
+            raise self._error(entity, str(exc)) from None
+
+        remap_scope = scope.child("")
+        env_scope = scope.child("")
+        for sub in entity.children:
+            tag = sub.tag.lower()
+            if tag == "remap":
+                pair = self._remap_pair(sub, scope)
+                if pair is not None:
+                    self._add_remap(sub, remap_scope, pair)
+            elif tag == "param":
+                self._param(sub, param_scope, force_local=True)
+            elif tag == "rosparam":
+                self._rosparam(sub, param_scope)
+            elif tag == "env":
+                self._env(sub, env_scope)
+            else:
+                self._warn(sub, f"unrecognized <{sub.tag}> tag in <{entity.tag}>")
+
+        for key, value in [*scope.params, *param_scope.params]:
+            if is_private(key):
+                key = key[1:]
+            self._set_param(param_scope.ns + key, value)
+
+        if respawn_flag and required_flag:
+            raise self._error(entity, "respawn and required cannot both be true")
+        if name and "/" in name:
+            raise self._error(entity, "node name cannot contain a namespace", "name")
+        if not pkg.strip():
+            raise self._error(entity, "package must be non-empty", "pkg")
+        if not node_type.strip():
+            raise self._error(entity, "type must be non-empty", "type")
+        if cwd == "ros_home":
+            cwd = "ROS_HOME"
+        if cwd not in ("ROS_HOME", "node", None):
+            raise self._error(entity, "must be one of 'ROS_HOME', 'node'", "cwd")
+        common = dict(package=pkg, type=node_type, name=name or None,
+                      namespace=make_global_ns(child.ns), machine_name=machine or None,
+                      args=args or "", remap_args=tuple(remap_scope.remap_args()),
+                      env_args=tuple(env_scope.env_args), cwd=cwd,
+                      launch_prefix=launch_prefix or None, filename=scope.filename,
+                      line=entity.location.line)
+        if is_test:
+            self.tests.append(Test(output="log", test_name=test_name, time_limit=time_limit,
+                                   retry=retry, **common))
+            return
+        if output not in ("log", "screen", None):
+            raise self._error(entity, "must be one of 'log', 'screen'", "output")
+        node = Node(respawn=respawn_flag, respawn_delay=delay, output=output,
+                    required=required_flag, **common)
+        full = node.full_name
+        if name and full in self._node_names:
+            raise self._error(entity, f"duplicate node name [{full}] (first declared at "
+                              f"{self._node_names[full]}); use unique names or $(anon id) "
+                              "with different ids", "name")
+        self._node_names[full] = entity.location
+        self.nodes.append(node)
+
+    # ---------------------------------------------------------------- include
+    def _include(self, entity: Entity, scope: Scope, default_machine: Machine | None
+                 ) -> Machine | None:
+        if not self._enabled(entity, scope):
+            return None
+        self._check_attrs(entity, INCLUDE_ATTRS)
+        (filename,) = self._req(entity, scope, "file")
+        pass_all = False
+        if "pass_all_args" in entity.attributes:
+            try:
+                pass_all = bool_attribute(self._resolve(entity, "pass_all_args", scope),
+                                          False, "pass_all_args")
+            except ValueError as exc:
+                raise self._error(entity, str(exc), "pass_all_args") from None
+        child = self._ns_and_clear_params(entity, scope, include_file=filename)
+        if pass_all:
+            for name, value in scope.args.items():
+                child.add_arg(name, value=value)
+            child.pass_all_args = True
+        for sub in entity.children:
+            tag = sub.tag.lower()
+            if tag == "env":
+                self._env(sub, child)
+            elif tag == "arg":
+                self._arg(sub, child)
+            else:
+                self._warn(sub, f"unrecognized <{sub.tag}> tag in <include>")
+        try:
+            child.enter_include()
+        except ScopeError as exc:
+            raise self._error(entity, str(exc)) from None
+
+        key = os.path.abspath(filename)
+        if key in scope.include_stack:
+            chain = " -> ".join([*scope.include_stack, key])
+            raise self._error(entity, f"include cycle: {chain}", "file")
+        if not os.path.isfile(filename):
+            raise self._error(entity, f"included file does not exist: [{filename}]", "file")
+        root = self._parse(filename)
+        child.include_stack = (*scope.include_stack, key)
+        self.files.append(filename)
+        self._check_launch_tag(root, child)
+        result = self._children(root.children, child, default_machine)
+        if not pass_all:
+            unused = child.unused_include_args()
+            if unused:
+                raise self._error(entity, f"unused args [{', '.join(unused)}] for include of "
+                                  f"[{filename}] (the included file does not declare them)")
+        return result
+
+    # ---------------------------------------------------------------- roscore
+    def _roscore(self) -> None:
+        """What roslaunch's roscore.xml adds before the user's files (run and list modes)."""
+        self._set_param("/rosversion", ROSLAUNCH_VERSION + "\n")
+        self._set_param("/rosdistro", os.environ.get("ROS_DISTRO", "noetic") + "\n")
+
+
+def _master(self: Interpreter, entity: Entity, scope: Scope, dm: Machine | None) -> None:
+    self._warn(entity, "ignoring defunct <master> tag")
+
+
+_TAGS: dict[str, Callable[..., Any]] = {
+    "group": Interpreter._group,
+    "node": Interpreter._node,
+    "test": Interpreter._test,
+    "param": Interpreter._param,
+    "remap": Interpreter._remap,
+    "machine": Interpreter._machine,
+    "rosparam": Interpreter._rosparam,
+    "master": _master,
+    "include": Interpreter._include,
+    "env": Interpreter._env,
+    "arg": Interpreter._arg,
+}
+
+
+def load_launch(path: str, args: dict[str, str] | None = None, *, no_exec: bool = False,
+                roscore: bool = False) -> LaunchPlan:
+    """Interpret the launch file at ``path`` with command-line ``args``; the plan."""
+    interp = Interpreter(LoadOptions(args=dict(args or {}), no_exec=no_exec, roscore=roscore))
+    interp.load_file(path)
+    return interp.plan()
+
+
+def binary_to_json(value: Any) -> Any:
+    """JSON form of values the plan may hold that JSON lacks (bytes, dates)."""
+    if isinstance(value, (bytes, bytearray)):
+        return {"__binary_b64__": base64.b64encode(bytes(value)).decode("ascii")}
+    if hasattr(value, "isoformat"):
+        return value.isoformat()
+    raise TypeError(f"cannot encode {type(value).__name__}")

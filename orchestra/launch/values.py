@@ -1,0 +1,68 @@
+"""Typed values from launch-file strings: ``<param type=...>``, if/unless and bool attributes.
+
+roslaunch's inference for ``type="auto"`` (the default): a string containing ``.`` that
+parses as a float is a float, otherwise one that parses as an int is an int; ``true`` /
+``false`` in any case are booleans; anything else stays a string. ``type="yaml"`` loads the
+text with rosparam's YAML rules and keeps the result whole.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+PARAM_TYPES = ("auto", "str", "string", "int", "double", "bool", "boolean", "yaml")
+
+
+def convert_value(value: str, type_: str) -> Any:
+    """``value`` converted to ``type_``; ``ValueError`` with a readable reason otherwise."""
+    type_ = type_.lower()
+    if type_ == "auto":
+        try:
+            return float(value) if "." in value else int(value)
+        except ValueError:
+            pass
+        lowered = value.lower()
+        if lowered in ("true", "false"):
+            return lowered == "true"
+        return value
+    if type_ in ("str", "string"):
+        return value
+    if type_ == "int":
+        return int(value)
+    if type_ == "double":
+        return float(value)
+    if type_ in ("bool", "boolean"):
+        lowered = value.lower().strip()
+        if lowered in ("true", "1"):
+            return True
+        if lowered in ("false", "0"):
+            return False
+        raise ValueError(f"{value!r} is not a '{type_}' value (true/false/1/0)")
+    if type_ == "yaml":
+        from orchestra.params.yaml import load_yaml_value
+        return load_yaml_value(value, "<yaml param>")
+    raise ValueError(f"unknown type '{type_}' (one of {', '.join(PARAM_TYPES)})")
+
+
+def bool_attribute(value: str | None, default: bool, label: str) -> bool:
+    """A ``true``/``false`` attribute (case-insensitive); empty or other text is an error."""
+    if value is None:
+        return default
+    lowered = value.lower()
+    if lowered == "true":
+        return True
+    if lowered == "false":
+        return False
+    if not value:
+        raise ValueError(f"bool value for {label} must be non-empty")
+    raise ValueError(f"invalid bool value for {label}: {value}")
+
+
+def float_attribute(value: str | None, default: float, label: str) -> float:
+    if value is None:
+        return default
+    if not value:
+        raise ValueError(f"value for {label} must be non-empty")
+    try:
+        return float(value)
+    except ValueError:
+        raise ValueError(f"invalid float value for {label}: {value}") from None
