@@ -1,0 +1,1 @@
+../../learning_tf/scripts/turtle_tf_listener.py
