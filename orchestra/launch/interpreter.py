@@ -22,6 +22,7 @@ from typing import Any, Callable
 from orchestra.errors import Location, OrchestraError
 from orchestra.launch.context import Scope, ScopeError
 from orchestra.launch.entity import Entity
+from orchestra.launch.files import read_text
 from orchestra.launch.plan import LaunchPlan, Machine, Node, Test
 from orchestra.launch.substitution import ArgNotSet, SubstitutionError, resolve
 from orchestra.launch.values import bool_attribute, convert_value, float_attribute
@@ -450,11 +451,9 @@ class Interpreter:
         source = file_ or entity.location.file
         if file_:
             try:
-                with open(file_, "r", encoding="utf-8") as fh:
-                    text = fh.read()
-            except OSError as exc:
-                raise self._error(entity, f"cannot read [{file_}]: {exc.strerror}",
-                                  "file") from None
+                text = read_text(file_)
+            except (OSError, UnicodeDecodeError) as exc:
+                raise self._error(entity, f"cannot read [{file_}]: {exc}", "file") from None
         else:
             text = entity.text or ""
         if subst_value:

@@ -215,10 +215,12 @@ def evaluate(expr: str, scope: Scope) -> Any:
     """Evaluate a ``$(eval)`` expression in the sandbox."""
     tree = _check_expression(expr)
 
-    def arg(name: str) -> str:
+    def arg(name: str) -> Any:
+        # like a bare name, arg('x') is typed: 'false' is False, '3' is 3
         if name not in scope.args:
             raise ArgNotSet(name)
-        return scope.args[name]
+        from orchestra.launch.values import convert_value
+        return convert_value(scope.args[name], "auto")
 
     def optenv(name: str, default: str = "") -> str:
         return os.environ.get(name, default)

@@ -88,9 +88,9 @@ def parse_string(text: str, filename: str = "<string>") -> Entity:
 
 def parse_file(path: str) -> Entity:
     """Parse a launch XML file; a missing or unreadable file is a user error, not a crash."""
+    from orchestra.launch.files import read_bytes
     try:
-        with open(path, "rb") as fh:
-            data = fh.read()
+        data = read_bytes(path)
     except OSError as exc:
         raise LaunchSyntaxError(f"cannot read launch file: {exc.strerror}",
                                 Location(path)) from None
