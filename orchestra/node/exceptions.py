@@ -1,0 +1,29 @@
+"""Exceptions of the node API, with rospy's names so that ported scripts catch the same things."""
+from __future__ import annotations
+
+
+class ROSException(Exception):
+    """Base error of the node runtime (timeouts, no master, bad state)."""
+
+
+class ROSInterruptException(ROSException, KeyboardInterrupt):
+    """Raised by blocking calls (``Rate.sleep``, ``wait_for_*``) once the node is shutting down.
+
+    It is also a KeyboardInterrupt, as in rospy, so an uncaught one ends a script quietly-ish.
+    """
+
+
+class ROSInitException(ROSException):
+    """``init_node`` could not be completed (bad name, called twice with another name)."""
+
+
+class ServiceException(ROSException):
+    """A service call failed: unknown service, refused connection, or the handler raised."""
+
+
+class TransportException(ROSException):
+    """A TCPROS connection broke or spoke an unexpected protocol."""
+
+
+class SerializationError(ROSException):
+    """A message value does not fit its declared field type."""

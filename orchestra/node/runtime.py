@@ -1,0 +1,593 @@
+"""The node runtime: one per process, created by ``init_node``.
+
+It owns the node's identity (name, namespace, remaps), its two servers (slave XML-RPC and
+TCPROS, both on ephemeral ports), its topics and services, and shutdown. Shutdown is the
+part rospy gets wrong most often, so it is explicit here: ``signal_shutdown`` marks the node
+as shutting down at once (``is_shutdown()`` turns true, sleeps wake up) and starts a
+non-daemon cleanup thread that runs the user's hooks, unregisters everything from the
+master and closes the sockets; ``spin()`` and interpreter exit wait for that thread, so a
+node never leaves stale registrations behind when it is interrupted.
+"""
+from __future__ import annotations
+
+import atexit
+import inspect
+import logging
+import os
+import signal
+import socket
+import sys
+import threading
+import time
+from typing import Any, Callable
+from urllib.parse import urlparse
+
+import yaml
+
+from orchestra.node import names, rostime, tcpros
+from orchestra.node.exceptions import (ROSException, ROSInitException, ROSInterruptException,
+                                       TransportException)
+from orchestra.node.masterapi import Master, MasterError
+from orchestra.node.topics import TopicManager
+
+log = logging.getLogger(__name__)
+DEFAULT_MASTER_URI = "http://localhost:11311/"
+_UNSET = object()
+
+
+def _advertise_host(special: dict[str, str], master_uri: str) -> str:
+    """The host other nodes should use to reach us (ROS_IP/ROS_HOSTNAME rules)."""
+    for key in ("__ip", "__hostname"):
+        if special.get(key):
+            return special[key]
+    for var in ("ROS_IP", "ROS_HOSTNAME"):
+        if os.environ.get(var):
+            return os.environ[var]
+    master_host = urlparse(master_uri).hostname or "localhost"
+    if master_host in ("localhost", "127.0.0.1", "::1") or master_host.startswith("127."):
+        return "127.0.0.1"
+    return socket.gethostname()
+
+
+class TcprosServer:
+    """Accepts TCPROS connections and hands each to the topic or service it asks for."""
+
+    def __init__(self, runtime: "NodeRuntime", bind_host: str, advertise_host: str):
+        self.rt = runtime
+        self.sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        self.sock.bind((bind_host, 0))
+        self.sock.listen(128)
+        self.port = self.sock.getsockname()[1]
+        self.host = advertise_host
+        self.closed = False
+        self.thread = threading.Thread(target=self._accept_loop, name="tcpros-accept", daemon=True)
+
+    def start(self) -> None:
+        self.thread.start()
+
+    def _accept_loop(self) -> None:
+        while not self.closed:
+            try:
+                conn, addr = self.sock.accept()
+            except OSError:
+                return
+            threading.Thread(target=self._handle, args=(conn, addr), daemon=True,
+                             name=f"tcpros-in-{addr[1]}").start()
+
+    def _handle(self, conn: socket.socket, addr) -> None:
+        conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        try:
+            conn.settimeout(10.0)
+            header = tcpros.read_header(conn)
+            conn.settimeout(None)
+        except (OSError, TransportException) as exc:
+            log.debug("bad TCPROS handshake from %s: %s", addr, exc)
+            conn.close()
+            return
+        try:
+            if "service" in header:
+                server = self.rt.services.get(header["service"])
+                if server is None:
+                    from orchestra.node.topics import _refuse
+                    _refuse(conn, f"no service [{header['service']}] provided by {self.rt.name}",
+                            f"{header.get('callerid')} asked for unknown service "
+                            f"{header['service']}")
+                    return
+                server.handle(conn, header)
+            elif "topic" in header:
+                self.rt.topics.handle_subscriber(conn, header)
+            else:
+                from orchestra.node.topics import _refuse
+                _refuse(conn, "no topic or service name detected",
+                        f"connection from {addr} named neither a topic nor a service")
+        except OSError as exc:
+            log.debug("TCPROS connection from %s failed: %s", addr, exc)
+            conn.close()
+
+    def stop(self) -> None:
+        self.closed = True
+        try:
+            self.sock.shutdown(socket.SHUT_RDWR)
+        except OSError:
+            pass
+        self.sock.close()
+
+
+class NodeRuntime:
+    """This process's node. Created once by ``init_node``; see the module docstring."""
+
+    def __init__(self, name: str, namespace: str, master_uri: str, remaps: dict[str, str],
+                 host: str, argv: list[str]):
+        self.name = name
+        self.namespace = namespace
+        self.master_uri = master_uri
+        self.remaps = remaps
+        self.argv = argv
+        self.master = Master(master_uri, name)
+        bind = host if host.startswith("127.") else "0.0.0.0"
+        self.topics = TopicManager(self)
+        self.services: dict[str, Any] = {}
+        self._services_lock = threading.Lock()
+        self._slave = None
+        self._tcpros = None
+        self._host, self._bind = host, bind
+        self._shutdown_requested = threading.Event()
+        self._shutdown_reason = ""
+        self._cleanup: threading.Thread | None = None
+        self._cleanup_lock = threading.Lock()
+        self._hooks: list[Callable[..., Any]] = []
+        self.params: dict[str, Any] = {}
+
+    def start(self) -> None:
+        from orchestra.node.slave import SlaveServer
+
+        self._tcpros = TcprosServer(self, self._bind, self._host)
+        self._slave = SlaveServer(self, self._bind, self._host)
+        self._tcpros.start()
+        self._slave.start()
+        rostime._set_shutdown_event(self._shutdown_requested)
+
+    @property
+    def uri(self) -> str:
+        return self._slave.uri if self._slave else ""
+
+    @property
+    def tcpros_address(self) -> tuple[str, int]:
+        return self._tcpros.host, self._tcpros.port
+
+    # names ----------------------------------------------------------------------------------
+    def resolve_name(self, name: str) -> str:
+        if not names.is_legal_name(name):
+            raise ValueError(f"illegal ROS name: {name!r}")
+        return names.resolve(name, self.namespace, self.name, self.remaps)
+
+    # master registration ------------------------------------------------------------------
+    def master_register(self, method: str, name: str, type_: str) -> Any:
+        """Register with the master, retrying while it is not up yet (as rospy does)."""
+        delay = 0.1
+        warned = False
+        while True:
+            try:
+                return self.master.call(method, name, type_, self.uri)
+            except MasterError as exc:
+                if exc.code is not None:
+                    raise ROSException(f"{method} {name}: {exc}") from exc
+                if self.is_shutdown():
+                    raise ROSInterruptException("shutdown while registering") from exc
+                if not warned:
+                    log.warning("cannot reach the master at %s, will keep trying", self.master_uri)
+                    warned = True
+                self._shutdown_requested.wait(delay)
+                delay = min(delay * 2, 2.0)
+
+    def master_unregister(self, method: str, name: str, api: str | None = None) -> None:
+        try:
+            self.master.call(method, name, api or self.uri)
+        except MasterError as exc:
+            log.debug("%s %s failed: %s", method, name, exc)
+
+    # services ---------------------------------------------------------------------------------
+    def add_service(self, server):
+        with self._services_lock:
+            if server.name in self.services:
+                raise ROSException(f"service {server.name} is already provided by this node")
+            self.services[server.name] = server
+        host, port = self.tcpros_address
+        try:
+            self.master.call("registerService", server.name, f"rosrpc://{host}:{port}", self.uri)
+        except MasterError as exc:
+            with self._services_lock:
+                self.services.pop(server.name, None)
+            raise ROSException(f"cannot register service {server.name}: {exc}") from exc
+        return server
+
+    def remove_service(self, server) -> None:
+        with self._services_lock:
+            if self.services.get(server.name) is not server:
+                return
+            del self.services[server.name]
+        host, port = self.tcpros_address
+        self.master_unregister("unregisterService", server.name, f"rosrpc://{host}:{port}")
+        server.close()
+
+    # introspection ----------------------------------------------------------------------------
+    def bus_stats(self) -> list:
+        pubs, subs = self.topics.bus_stats()
+        with self._services_lock:
+            calls = sum(s.calls for s in self.services.values())
+        return [pubs, subs, [0, calls, 0]]
+
+    def bus_info(self) -> list:
+        return self.topics.bus_info()
+
+    def param_updated(self, key: str, value: Any) -> None:
+        self.params[key] = value
+
+    # shutdown -------------------------------------------------------------------------------------
+    def is_shutdown(self) -> bool:
+        return self._shutdown_requested.is_set()
+
+    def add_hook(self, hook: Callable[..., Any]) -> None:
+        if self.is_shutdown():
+            _call_hook(hook, self._shutdown_reason)
+            return
+        self._hooks.append(hook)
+
+    def signal_shutdown(self, reason: str) -> None:
+        with self._cleanup_lock:
+            if self._cleanup is not None:
+                return
+            self._shutdown_reason = reason
+            self._shutdown_requested.set()
+            log.info("shutdown: %s", reason)
+            self._cleanup = threading.Thread(target=self._do_cleanup, name="node-shutdown",
+                                             daemon=False)
+            self._cleanup.start()
+
+    def wait_shutdown_done(self, timeout: float | None = 10.0) -> None:
+        thread = self._cleanup
+        if thread is not None and thread is not threading.current_thread():
+            thread.join(timeout)
+
+    def _do_cleanup(self) -> None:
+        for hook in list(self._hooks):
+            _call_hook(hook, self._shutdown_reason)
+        self.topics.close_all()
+        with self._services_lock:
+            servers = list(self.services.values())
+        for server in servers:
+            self.remove_service(server)
+        if self._tcpros:
+            self._tcpros.stop()
+        if self._slave:
+            self._slave.stop()
+
+
+def _call_hook(hook: Callable[..., Any], reason: str) -> None:
+    try:
+        try:
+            params = inspect.signature(hook).parameters
+        except (TypeError, ValueError):
+            params = {}
+        if params:
+            hook(reason)
+        else:
+            hook()
+    except Exception:
+        log.exception("error in shutdown hook %r", hook)
+
+
+# --- the process-wide node --------------------------------------------------------------------
+
+_runtime: NodeRuntime | None = None
+_init_lock = threading.Lock()
+
+
+def get_runtime() -> NodeRuntime:
+    if _runtime is None:
+        raise ROSInitException("init_node() has not been called in this process")
+    return _runtime
+
+
+def _parse_master_uri(uri: str) -> str:
+    return uri if uri.endswith("/") else uri + "/"
+
+
+def init_node(name: str, argv: list[str] | None = None, anonymous: bool = False,
+              log_level: int | None = None, disable_rostime: bool = False,
+              disable_rosout: bool = False, disable_signals: bool = False,
+              xmlrpc_port: int = 0, tcpros_port: int = 0) -> None:
+    """Make this process the node ``name`` (see rospy.init_node; same argv conventions)."""
+    global _runtime
+    argv = list(sys.argv if argv is None else argv)
+    parsed = names.parse_args(argv)
+    special = parsed.special
+    if "__name" in special:
+        name = special["__name"]
+        anonymous = False
+    if not name or "/" in name or "~" in name or not names.is_legal_name(name):
+        raise ValueError(f"illegal node name {name!r}: no namespaces or '~' in node names")
+    if anonymous:
+        name = names.anonymous_name(name)
+    namespace = names.make_global_ns(special.get("__ns") or os.environ.get("ROS_NAMESPACE") or "/")
+    full_name = namespace + name
+    with _init_lock:
+        if _runtime is not None:
+            if _runtime.name == full_name:
+                return
+            raise ROSInitException(f"init_node() was already called as {_runtime.name}")
+        master_uri = _parse_master_uri(special.get("__master")
+                                       or os.environ.get("ROS_MASTER_URI") or DEFAULT_MASTER_URI)
+        remaps = names.resolve_remaps(parsed.remaps, namespace, full_name)
+        host = _advertise_host(special, master_uri)
+        runtime = NodeRuntime(full_name, namespace, master_uri, remaps, host, argv)
+        runtime.start()
+        _runtime = runtime
+    _setup_logging(log_level)
+    atexit.register(_at_exit)
+    if not disable_signals and threading.current_thread() is threading.main_thread():
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(sig, _on_signal)
+    for key, text in parsed.private_params.items():
+        try:
+            value = yaml.safe_load(text) if text != "" else ""
+        except yaml.YAMLError:
+            value = text
+        set_param("~" + key, value)
+    if not disable_rosout:
+        runtime.rosout = _make_rosout()
+
+
+def _on_signal(signum, frame) -> None:
+    signal_shutdown(f"signal {signal.Signals(signum).name}")
+
+
+def _at_exit() -> None:
+    if _runtime is not None:
+        _runtime.signal_shutdown("process exit")
+        _runtime.wait_shutdown_done()
+
+
+# --- the rospy-style functions -----------------------------------------------------------------
+
+def get_name() -> str:
+    return get_runtime().name
+
+
+def get_namespace() -> str:
+    return get_runtime().namespace
+
+
+def get_caller_id() -> str:
+    return get_runtime().name
+
+
+def get_node_uri() -> str:
+    return get_runtime().uri
+
+
+def get_master_uri() -> str:
+    return get_runtime().master_uri
+
+
+def resolve_name(name: str, caller_id: str | None = None) -> str:
+    rt = get_runtime()
+    if caller_id is None:
+        return rt.resolve_name(name)
+    return names.resolve(name, names.namespace_of(caller_id), caller_id, rt.remaps)
+
+
+def remap_name(name: str) -> str:
+    return get_runtime().remaps.get(name, name)
+
+
+def myargv(argv: list[str] | None = None) -> list[str]:
+    """``argv`` (default ``sys.argv``) without the ROS ``name:=value`` arguments."""
+    argv = sys.argv if argv is None else argv
+    return [a for a in argv if not names.is_remap_arg(a)]
+
+
+def is_shutdown() -> bool:
+    return _runtime is not None and _runtime.is_shutdown()
+
+
+def signal_shutdown(reason: str) -> None:
+    if _runtime is not None:
+        _runtime.signal_shutdown(reason)
+
+
+def on_shutdown(callback: Callable[..., Any]) -> None:
+    get_runtime().add_hook(callback)
+
+
+def spin() -> None:
+    """Block until the node is shut down (and its cleanup has finished)."""
+    rt = get_runtime()
+    try:
+        while not rt._shutdown_requested.wait(0.5):
+            pass
+    except KeyboardInterrupt:
+        rt.signal_shutdown("keyboard interrupt")
+    rt.wait_shutdown_done()
+
+
+# params -------------------------------------------------------------------------------------------
+
+def get_param(name: str, default: Any = _UNSET) -> Any:
+    rt = get_runtime()
+    key = rt.resolve_name(name)
+    code, msg, value = rt.master.raw("getParam", key)
+    if code != 1:
+        if default is _UNSET:
+            raise KeyError(name)
+        return default
+    return value
+
+
+def get_param_cached(name: str, default: Any = _UNSET) -> Any:
+    return get_param(name, default)
+
+
+def set_param(name: str, value: Any) -> None:
+    rt = get_runtime()
+    rt.master.call("setParam", rt.resolve_name(name), value)
+
+
+def has_param(name: str) -> bool:
+    rt = get_runtime()
+    return bool(rt.master.call("hasParam", rt.resolve_name(name)))
+
+
+def delete_param(name: str) -> None:
+    rt = get_runtime()
+    code, msg, _ = rt.master.raw("deleteParam", rt.resolve_name(name))
+    if code != 1:
+        raise KeyError(name)
+
+
+def search_param(name: str) -> str | None:
+    rt = get_runtime()
+    code, msg, value = rt.master.raw("searchParam", name)
+    return value if code == 1 and value else None
+
+
+def get_param_names() -> list[str]:
+    return list(get_runtime().master.call("getParamNames"))
+
+
+def get_published_topics(namespace: str = "/") -> list[list[str]]:
+    return [list(t) for t in get_runtime().master.call("getPublishedTopics", namespace)]
+
+
+# waiting ----------------------------------------------------------------------------------------
+
+def wait_for_message(topic: str, topic_type, timeout: float | None = None):
+    """The next message on ``topic``; ``ROSException`` if none arrives within ``timeout``."""
+    from orchestra.node.topics import Subscriber
+
+    got: list = []
+    event = threading.Event()
+
+    def callback(msg):
+        if not got:
+            got.append(msg)
+            event.set()
+
+    sub = Subscriber(topic, topic_type, callback)
+    try:
+        deadline = None if timeout is None else time.monotonic() + timeout
+        while not event.is_set():
+            if is_shutdown():
+                raise ROSInterruptException("rospy shutdown")
+            remaining = 0.2 if deadline is None else min(0.2, deadline - time.monotonic())
+            if remaining <= 0:
+                raise ROSException(f"timeout exceeded while waiting for message on "
+                                   f"{sub.resolved_name}")
+            event.wait(remaining)
+        return got[0]
+    finally:
+        sub.unregister()
+
+
+# logging ----------------------------------------------------------------------------------------
+
+_LEVELS = {logging.DEBUG: ("DEBUG", 1), logging.INFO: ("INFO", 2), logging.WARNING: ("WARN", 4),
+           logging.ERROR: ("ERROR", 8), logging.CRITICAL: ("FATAL", 16)}
+_user_log = logging.getLogger("rosout")
+
+
+class _ConsoleHandler(logging.Handler):
+    """rospy's console format: ``[INFO] [secs.usecs]: text``; warnings and worse on stderr."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        label = _LEVELS.get(record.levelno, ("INFO", 2))[0]
+        stream = sys.stdout if record.levelno < logging.WARNING else sys.stderr
+        try:
+            stream.write(f"[{label}] [{record.created:.6f}]: {record.getMessage()}\n")
+            stream.flush()
+        except (OSError, ValueError):
+            pass
+
+
+def _setup_logging(level: int | None) -> None:
+    if not any(isinstance(h, _ConsoleHandler) for h in _user_log.handlers):
+        _user_log.addHandler(_ConsoleHandler())
+    _user_log.propagate = False
+    _user_log.setLevel(level if level is not None and level >= 10 else logging.INFO)
+
+
+def _make_rosout():
+    from orchestra.node.msg import get_message_class
+    from orchestra.node.topics import Publisher
+
+    try:
+        return Publisher("/rosout", get_message_class("rosgraph_msgs/Log"), queue_size=100)
+    except ROSException as exc:
+        log.warning("no /rosout publisher: %s", exc)
+        return None
+
+
+def _log(level: int, msg: Any, args: tuple) -> None:
+    text = str(msg) % args if args else str(msg)
+    if _user_log.isEnabledFor(level):
+        _user_log.log(level, text)
+    rt = _runtime
+    pub = getattr(rt, "rosout", None) if rt is not None else None
+    if pub is None or rt.is_shutdown():
+        return
+    frame = inspect.currentframe()
+    caller = frame.f_back.f_back if frame and frame.f_back else None
+    try:
+        from orchestra.node.rostime import Time
+        m = pub.data_class(level=_LEVELS[level][1], name=rt.name, msg=text,
+                           file=caller.f_code.co_filename if caller else "",
+                           function=caller.f_code.co_name if caller else "",
+                           line=caller.f_lineno if caller else 0,
+                           topics=[t for t, _ in rt.topics.publication_list()])
+        m.header.stamp = Time.now()
+        pub.publish(m)
+    except ROSException:
+        pass
+    finally:
+        del frame, caller
+
+
+def logdebug(msg: Any, *args: Any) -> None:
+    _log(logging.DEBUG, msg, args)
+
+
+def loginfo(msg: Any, *args: Any) -> None:
+    _log(logging.INFO, msg, args)
+
+
+def logwarn(msg: Any, *args: Any) -> None:
+    _log(logging.WARNING, msg, args)
+
+
+def logerr(msg: Any, *args: Any) -> None:
+    _log(logging.ERROR, msg, args)
+
+
+def logfatal(msg: Any, *args: Any) -> None:
+    _log(logging.CRITICAL, msg, args)
+
+
+logwarn_throttle_state: dict[tuple, float] = {}
+
+
+def loginfo_throttle(period: float, msg: Any, *args: Any) -> None:
+    _throttled(logging.INFO, period, msg, args)
+
+
+def logwarn_throttle(period: float, msg: Any, *args: Any) -> None:
+    _throttled(logging.WARNING, period, msg, args)
+
+
+def _throttled(level: int, period: float, msg: Any, args: tuple) -> None:
+    frame = inspect.currentframe().f_back.f_back
+    key = (frame.f_code.co_filename, frame.f_lineno)
+    now = time.monotonic()
+    if now - logwarn_throttle_state.get(key, -1e18) >= period:
+        logwarn_throttle_state[key] = now
+        _log(level, msg, args)

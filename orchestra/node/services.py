@@ -1,0 +1,273 @@
+"""Services over TCPROS: ``Service`` (serve a handler) and ``ServiceProxy`` (call one).
+
+Wire rules (ROS 1): the client sends a header with ``service``, ``md5sum``, ``callerid`` and
+optionally ``persistent=1`` or ``probe=1``; the server answers with its header (or an
+``error`` header and closes). Each request is length-prefixed; each reply is an ok byte
+(1/0) then a length-prefixed response or error string. A non-persistent connection carries
+one call; a persistent one carries calls until the client closes it.
+"""
+from __future__ import annotations
+
+import logging
+import socket
+import threading
+import time
+from typing import TYPE_CHECKING, Any, Callable
+
+from orchestra.node import tcpros
+from orchestra.node.exceptions import (ROSException, ROSInterruptException, ServiceException,
+                                       TransportException)
+from orchestra.node.masterapi import MasterError
+from orchestra.node.msg import Message, ServiceDefinition
+
+if TYPE_CHECKING:
+    from orchestra.node.runtime import NodeRuntime
+
+log = logging.getLogger(__name__)
+
+
+def _as_response(value: Any, response_class: type[Message]) -> Message:
+    """What a handler returned, as a response message (rospy accepts these shapes too)."""
+    if isinstance(value, response_class):
+        return value
+    if value is None:
+        return response_class()
+    if isinstance(value, Message):
+        raise ServiceException(f"handler returned a {value._type}, expected "
+                               f"{response_class._type}")
+    if isinstance(value, dict):
+        return response_class(**value)
+    if isinstance(value, (list, tuple)):
+        return response_class(*value)
+    if len(response_class._fields) == 1:
+        return response_class(value)
+    raise ServiceException(f"handler returned {value!r}, expected {response_class._type}")
+
+
+class ServiceServer:
+    """One service this node offers (shared by the ``Service`` handle that created it)."""
+
+    def __init__(self, runtime: "NodeRuntime", name: str, srv_class: type[ServiceDefinition],
+                 handler: Callable):
+        self.runtime = runtime
+        self.name = name
+        self.srv_class = srv_class
+        self.handler = handler
+        self.calls = 0
+        self.closed = False
+        self.sockets: set[socket.socket] = set()
+        self.lock = threading.Lock()
+
+    def header(self) -> dict[str, str]:
+        cls = self.srv_class
+        return {"callerid": self.runtime.name, "service": self.name, "md5sum": cls._md5sum,
+                "type": cls._type, "request_type": cls._request_class._type,
+                "response_type": cls._response_class._type}
+
+    def handle(self, sock: socket.socket, header: dict[str, str]) -> None:
+        """Serve one client connection (runs on the connection's own thread)."""
+        from orchestra.node.topics import _refuse
+
+        caller = header.get("callerid", "?")
+        cls = self.srv_class
+        if header.get("probe") == "1":
+            try:
+                tcpros.write_header(sock, self.header())
+            finally:
+                sock.close()
+            return
+        their = header.get("md5sum", "")
+        if their not in ("*", cls._md5sum):
+            _refuse(sock, f"request from [{caller}]: md5sums do not match: [{their}] vs. "
+                          f"[{cls._md5sum}]",
+                    f"refused call of {self.name} by {caller}: it expects md5 {their}, "
+                    f"the service is {cls._type} ({cls._md5sum})")
+            return
+        persistent = header.get("persistent") == "1"
+        with self.lock:
+            self.sockets.add(sock)
+        try:
+            tcpros.write_header(sock, self.header())
+            while not self.closed:
+                try:
+                    data = tcpros.read_message(sock)
+                except TransportException:
+                    return
+                self._answer(sock, data, caller)
+                if not persistent:
+                    return
+        except OSError as exc:
+            log.debug("service %s: connection from %s broke: %s", self.name, caller, exc)
+        finally:
+            with self.lock:
+                self.sockets.discard(sock)
+            sock.close()
+
+    def _answer(self, sock: socket.socket, data: bytes, caller: str) -> None:
+        cls = self.srv_class
+        try:
+            request = cls._request_class.deserialize_bytes(data)
+            response = _as_response(self.handler(request), cls._response_class)
+            body = response.serialize_bytes()
+        except Exception as exc:  # the handler's error goes back to the caller
+            log.error("service %s: error processing request from %s: %s", self.name, caller, exc)
+            tcpros.send_service_response(sock, False,
+                                         f"error processing request: {exc}".encode("utf-8"))
+            return
+        self.calls += 1
+        tcpros.send_service_response(sock, True, body)
+
+    def close(self) -> None:
+        self.closed = True
+        with self.lock:
+            socks = list(self.sockets)
+        for sock in socks:
+            try:
+                sock.shutdown(socket.SHUT_RDWR)
+            except OSError:
+                pass
+
+
+class Service:
+    """Offer ``name`` (resolved like rospy): ``handler(request)`` returns the response."""
+
+    def __init__(self, name: str, service_class: type[ServiceDefinition], handler: Callable,
+                 **_ignored: Any):
+        from orchestra.node.runtime import get_runtime
+
+        self._rt = get_runtime()
+        self.resolved_name = self.name = self._rt.resolve_name(name)
+        self.service_class = service_class
+        self.handler = handler
+        self._impl = self._rt.add_service(ServiceServer(self._rt, self.name, service_class,
+                                                        handler))
+
+    def shutdown(self, reason: str = "") -> None:
+        self._rt.remove_service(self._impl)
+
+    unregister = shutdown
+
+    def spin(self) -> None:
+        from orchestra.node.runtime import spin
+        spin()
+
+
+def _open(runtime_name: str, master, name: str, srv_class: type[ServiceDefinition],
+          persistent: bool, probe: bool = False,
+          timeout: float | None = 10.0) -> tuple[socket.socket, dict[str, str]]:
+    try:
+        uri = master.call("lookupService", name)
+    except MasterError as exc:
+        raise ServiceException(f"service [{name}] unavailable") from exc
+    host, port = tcpros.parse_rosrpc_uri(uri)
+    try:
+        sock = tcpros.connect(host, port, timeout=timeout)
+    except OSError as exc:
+        raise ServiceException(f"unable to connect to service [{name}] at {uri}: {exc}") from exc
+    fields = {"callerid": runtime_name, "service": name, "md5sum": srv_class._md5sum,
+              "type": srv_class._type}
+    if persistent:
+        fields["persistent"] = "1"
+    if probe:
+        fields["probe"] = "1"
+    try:
+        tcpros.write_header(sock, fields)
+        header = tcpros.read_header(sock)
+    except (OSError, TransportException) as exc:
+        sock.close()
+        raise ServiceException(f"service [{name}]: connection failed: {exc}") from exc
+    if "error" in header:
+        sock.close()
+        raise ServiceException(f"service [{name}] refused the connection: {header['error']}")
+    return sock, header
+
+
+class ServiceProxy:
+    """Call a service: ``proxy(request)`` or ``proxy(**fields)`` returns the response."""
+
+    def __init__(self, name: str, service_class: type[ServiceDefinition],
+                 persistent: bool = False, headers: dict | None = None):
+        from orchestra.node.runtime import get_runtime
+
+        self._rt = get_runtime()
+        self.resolved_name = self.name = self._rt.resolve_name(name)
+        self.service_class = self.request_class = service_class
+        self.request_class = service_class._request_class
+        self.response_class = service_class._response_class
+        self.persistent = persistent
+        self._sock: socket.socket | None = None
+        self._lock = threading.Lock()
+
+    def wait_for_service(self, timeout: float | None = None) -> None:
+        wait_for_service(self.name, timeout)
+
+    def __call__(self, *args, **kwargs) -> Message:
+        return self.call(*args, **kwargs)
+
+    def call(self, *args, **kwargs) -> Message:
+        if len(args) == 1 and not kwargs and isinstance(args[0], Message):
+            request = args[0]
+            if request._type != self.request_class._type:
+                raise ServiceException(f"expected a {self.request_class._type} request, "
+                                       f"got {request._type}")
+        else:
+            request = self.request_class(*args, **kwargs)
+        body = request.serialize_bytes()
+        with self._lock:
+            sock = self._sock
+            if sock is None:
+                sock, _ = _open(self._rt.name, self._rt.master, self.name, self.service_class,
+                                self.persistent)
+            try:
+                tcpros.send_message(sock, body)
+                ok, reply = tcpros.read_service_response(sock)
+            except (OSError, TransportException) as exc:
+                sock.close()
+                self._sock = None
+                raise ServiceException(f"service [{self.name}]: connection lost: {exc}") from exc
+            if self.persistent:
+                self._sock = sock
+            else:
+                sock.close()
+        if not ok:
+            raise ServiceException(f"service [{self.name}] responded with an error: "
+                                   f"{reply.decode('utf-8', 'replace')}")
+        return self.response_class.deserialize_bytes(reply)
+
+    def close(self) -> None:
+        with self._lock:
+            if self._sock is not None:
+                self._sock.close()
+                self._sock = None
+
+    def __del__(self):
+        sock = getattr(self, "_sock", None)
+        if sock is not None:
+            sock.close()
+
+
+def wait_for_service(name: str, timeout: float | None = None) -> None:
+    """Block until ``name`` is registered and answers a probe; ``ROSException`` on timeout."""
+    from orchestra.node.runtime import get_runtime
+
+    rt = get_runtime()
+    resolved = rt.resolve_name(name)
+    deadline = None if timeout is None else time.monotonic() + timeout
+    delay = 0.01
+    while True:
+        if rt.is_shutdown():
+            raise ROSInterruptException("rospy shutdown")
+        try:
+            uri = rt.master.call("lookupService", resolved)
+            host, port = tcpros.parse_rosrpc_uri(uri)
+            with tcpros.connect(host, port, timeout=1.0) as sock:
+                tcpros.write_header(sock, {"callerid": rt.name, "service": resolved,
+                                           "md5sum": "*", "probe": "1"})
+                tcpros.read_header(sock)
+            return
+        except (MasterError, OSError, TransportException, ROSException):
+            pass
+        if deadline is not None and time.monotonic() >= deadline:
+            raise ROSException(f"timeout exceeded while waiting for service {resolved}")
+        time.sleep(delay if deadline is None else max(0.0, min(delay, deadline - time.monotonic())))
+        delay = min(delay * 2, 0.2)

@@ -1,0 +1,575 @@
+"""Topics: publications with per-subscriber writer queues, subscriptions with reconnecting
+readers, and the ``Publisher`` / ``Subscriber`` handles user code holds.
+
+Several handles on one topic share one implementation object (as in rospy), so a node that
+creates two Publishers on ``/chatter`` registers once and serves each subscriber over one
+connection. Threads: one writer per outgoing connection (a slow subscriber drops its own
+oldest messages, never blocks ``publish``) and one reader per publisher we subscribe to
+(it calls the callbacks, reconnects with backoff while that publisher is still listed).
+"""
+from __future__ import annotations
+
+import collections
+import logging
+import socket
+import threading
+import time
+from typing import TYPE_CHECKING, Any, Callable
+
+from orchestra.node import tcpros
+from orchestra.node.exceptions import ROSException, TransportException
+from orchestra.node.masterapi import MasterError, raw_call
+from orchestra.node.msg import AnyMsg, Message
+
+if TYPE_CHECKING:
+    from orchestra.node.runtime import NodeRuntime
+
+log = logging.getLogger(__name__)
+
+RECONNECT_MIN = 0.05
+RECONNECT_MAX = 2.0
+
+
+def md5_compatible(a: str, b: str) -> bool:
+    return a == "*" or b == "*" or a == b
+
+
+# --- publishing -------------------------------------------------------------------------------
+
+class OutConnection:
+    """One subscriber of one of our topics: a bounded drop-oldest queue and a writer thread."""
+
+    _ids = iter(range(1, 1 << 62))
+
+    def __init__(self, publication: "Publication", sock: socket.socket, peer: str,
+                 queue_size: int | None):
+        self.id = next(OutConnection._ids)
+        self.publication = publication
+        self.sock = sock
+        self.peer = peer
+        self.queue: collections.deque = collections.deque(maxlen=queue_size or None)
+        self.cond = threading.Condition()
+        self.closed = False
+        self.bytes_sent = 0
+        self.messages_sent = 0
+        self.dropped = 0
+        self.thread = threading.Thread(target=self._run, daemon=True,
+                                       name=f"pub{publication.topic}->{peer}")
+
+    def enqueue(self, data) -> None:
+        with self.cond:
+            if self.closed:
+                return
+            if self.queue.maxlen is not None and len(self.queue) == self.queue.maxlen:
+                self.dropped += 1
+            self.queue.append(data)
+            self.cond.notify()
+
+    def _run(self) -> None:
+        sock = self.sock
+        while True:
+            with self.cond:
+                while not self.queue and not self.closed:
+                    self.cond.wait()
+                if self.closed:
+                    return
+                data = self.queue.popleft()
+            try:
+                tcpros.send_message(sock, data)
+            except OSError as exc:
+                log.debug("subscriber %s of %s went away: %s", self.peer,
+                          self.publication.topic, exc)
+                self.publication.remove_connection(self)
+                return
+            self.bytes_sent += len(data) + 4
+            self.messages_sent += 1
+
+    def close(self) -> None:
+        with self.cond:
+            self.closed = True
+            self.cond.notify()
+        try:
+            self.sock.shutdown(socket.SHUT_RDWR)
+        except OSError:
+            pass
+        self.sock.close()
+
+
+class Publication:
+    """Everything this node knows about one topic it publishes."""
+
+    def __init__(self, runtime: "NodeRuntime", topic: str, msg_class: type[Message],
+                 latch: bool, queue_size: int | None):
+        self.runtime = runtime
+        self.topic = topic
+        self.msg_class = msg_class
+        self.latch = latch
+        self.queue_size = queue_size
+        self.lock = threading.Lock()
+        self.connections: list[OutConnection] = []
+        self.latched: bytes | None = None
+        self.handles = 0
+        self.seq = 0
+        self.messages = 0
+        self.closed = False
+
+    @property
+    def type(self) -> str:
+        return self.msg_class._type
+
+    def publish(self, msg: Message) -> None:
+        if self.closed:
+            raise ROSException(f"publish() to {self.topic} after unregister()")
+        if msg._type != self.msg_class._type and self.msg_class is not AnyMsg:
+            raise ROSException(f"expected a {self.msg_class._type} message on {self.topic}, "
+                               f"got {msg._type}")
+        with self.lock:
+            self.seq += 1
+            if msg._has_header:
+                msg.header.seq = self.seq
+            data = msg.serialize_bytes()
+            if self.latch:
+                self.latched = data
+            conns = list(self.connections)
+            self.messages += 1
+        for conn in conns:
+            conn.enqueue(data)
+
+    def add_connection(self, sock: socket.socket, header: dict[str, str]) -> OutConnection:
+        conn = OutConnection(self, sock, header.get("callerid", "?"), self.queue_size)
+        with self.lock:
+            if self.latched is not None:
+                conn.queue.append(self.latched)
+            self.connections.append(conn)
+        conn.thread.start()
+        return conn
+
+    def remove_connection(self, conn: OutConnection) -> None:
+        with self.lock:
+            if conn in self.connections:
+                self.connections.remove(conn)
+        conn.close()
+
+    def num_connections(self) -> int:
+        with self.lock:
+            return len(self.connections)
+
+    def close(self) -> None:
+        with self.lock:
+            self.closed = True
+            conns, self.connections = self.connections, []
+        for conn in conns:
+            conn.close()
+
+
+class Publisher:
+    """Publish messages of ``msg_class`` on ``topic`` (name resolved like rospy)."""
+
+    def __init__(self, topic: str, msg_class: type[Message], queue_size: int | None = 10,
+                 latch: bool = False, **_ignored: Any):
+        from orchestra.node.runtime import get_runtime
+
+        if not (isinstance(msg_class, type) and issubclass(msg_class, Message)):
+            raise ValueError(f"Publisher needs a message class, not {msg_class!r}")
+        self._rt = get_runtime()
+        self.resolved_name = self.name = self._rt.resolve_name(topic)
+        self.data_class = msg_class
+        self.type = msg_class._type
+        self.md5sum = msg_class._md5sum
+        self._impl = self._rt.topics.acquire_publication(self.name, msg_class, latch, queue_size)
+        self._done = False
+
+    def publish(self, *args, **kwargs) -> None:
+        """Send a message: an instance, or the field values to build one from."""
+        if self._done:
+            raise ROSException(f"publish() to {self.name} after unregister()")
+        if len(args) == 1 and not kwargs and isinstance(args[0], Message):
+            msg = args[0]
+        else:
+            msg = self.data_class(*args, **kwargs)
+        self._impl.publish(msg)
+
+    def get_num_connections(self) -> int:
+        return self._impl.num_connections()
+
+    def unregister(self) -> None:
+        if not self._done:
+            self._done = True
+            self._rt.topics.release_publication(self._impl)
+
+
+# --- subscribing ------------------------------------------------------------------------------
+
+class InConnection:
+    """Our link to one publisher: connect, read, dispatch, reconnect with backoff."""
+
+    def __init__(self, subscription: "Subscription", publisher_uri: str):
+        self.subscription = subscription
+        self.uri = publisher_uri
+        self.closed = threading.Event()
+        self.sock: socket.socket | None = None
+        self.connected = False
+        self.header: dict[str, str] = {}
+        self.bytes_received = 0
+        self.messages_received = 0
+        self.drops = 0
+        self.id = next(OutConnection._ids)
+        self.thread = threading.Thread(target=self._run, daemon=True,
+                                       name=f"sub{subscription.topic}<-{publisher_uri}")
+
+    def start(self) -> None:
+        self.thread.start()
+
+    def close(self) -> None:
+        self.closed.set()
+        sock = self.sock
+        if sock is not None:
+            try:
+                sock.shutdown(socket.SHUT_RDWR)
+            except OSError:
+                pass
+
+    def _connect(self) -> socket.socket:
+        sub = self.subscription
+        rt = sub.runtime
+        code, msg, proto = raw_call(self.uri, "requestTopic", rt.name, sub.topic, [["TCPROS"]],
+                                    timeout=5.0)
+        if code != 1 or not proto or proto[0] != "TCPROS":
+            raise TransportException(f"publisher {self.uri} refused {sub.topic}: {msg}")
+        sock = tcpros.connect(proto[1], int(proto[2]))
+        try:
+            cls = sub.msg_class
+            tcpros.write_header(sock, {
+                "callerid": rt.name, "topic": sub.topic, "md5sum": cls._md5sum,
+                "type": cls._type, "message_definition": cls._full_text, "tcp_nodelay": "1"})
+            header = tcpros.read_header(sock)
+        except BaseException:
+            sock.close()
+            raise
+        if "error" in header:
+            sock.close()
+            raise _Refused(header["error"])
+        if not md5_compatible(cls._md5sum, header.get("md5sum", "*")):
+            sock.close()
+            raise _Refused(f"publisher sends {header.get('type')} "
+                           f"(md5 {header.get('md5sum')}), we expect {cls._type} "
+                           f"(md5 {cls._md5sum})")
+        self.header = header
+        return sock
+
+    def _run(self) -> None:
+        sub = self.subscription
+        backoff = RECONNECT_MIN
+        while not self.closed.is_set():
+            try:
+                sock = self._connect()
+            except _Refused as exc:
+                log.error("subscription to %s from %s refused: %s", sub.topic, self.uri, exc)
+                return
+            except (OSError, TransportException, MasterError) as exc:
+                log.debug("cannot connect to %s for %s: %s", self.uri, sub.topic, exc)
+                if self.closed.wait(backoff):
+                    return
+                backoff = min(backoff * 2, RECONNECT_MAX)
+                continue
+            self.sock = sock
+            if self.closed.is_set():
+                sock.close()
+                return
+            self.connected = True
+            backoff = RECONNECT_MIN
+            try:
+                self._read_loop(sock)
+            except (OSError, TransportException) as exc:
+                log.debug("connection to %s for %s lost: %s", self.uri, sub.topic, exc)
+            finally:
+                self.connected = False
+                self.sock = None
+                sock.close()
+            if self.closed.wait(backoff):
+                return
+
+    def _read_loop(self, sock: socket.socket) -> None:
+        sub = self.subscription
+        header = self.header
+        cls = sub.msg_class
+        while not self.closed.is_set():
+            data = tcpros.read_message(sock)
+            self.bytes_received += len(data) + 4
+            self.messages_received += 1
+            if cls is AnyMsg:
+                msg = AnyMsg(data)
+            else:
+                try:
+                    msg = cls.deserialize_bytes(data)
+                except ROSException as exc:
+                    log.error("bad message on %s from %s: %s", sub.topic, self.uri, exc)
+                    continue
+            msg._connection_header = header
+            sub.deliver(msg)
+
+
+class _Refused(Exception):
+    """The publisher refused us for a reason retrying will not fix (type mismatch)."""
+
+
+class Subscription:
+    """Everything this node knows about one topic it subscribes to."""
+
+    def __init__(self, runtime: "NodeRuntime", topic: str, msg_class: type[Message]):
+        self.runtime = runtime
+        self.topic = topic
+        self.msg_class = msg_class
+        self.lock = threading.Lock()
+        self.callback_lock = threading.Lock()
+        self.callbacks: list[tuple[Callable, Any]] = []
+        self.connections: dict[str, InConnection] = {}
+        self.closed = False
+
+    @property
+    def type(self) -> str:
+        return self.msg_class._type
+
+    def add_callback(self, cb: Callable, cb_args: Any) -> None:
+        with self.lock:
+            self.callbacks.append((cb, cb_args))
+
+    def remove_callback(self, cb: Callable, cb_args: Any) -> int:
+        with self.lock:
+            for i, (c, a) in enumerate(self.callbacks):
+                if c is cb and a is cb_args:
+                    del self.callbacks[i]
+                    break
+            return len(self.callbacks)
+
+    def deliver(self, msg: Message) -> None:
+        callbacks = self.callbacks
+        with self.callback_lock:
+            for cb, args in callbacks:
+                try:
+                    if args is None:
+                        cb(msg)
+                    else:
+                        cb(msg, args)
+                except Exception:  # a user callback must not kill the connection
+                    log.exception("error in callback for %s", self.topic)
+
+    def update_publishers(self, uris: list[str]) -> None:
+        """Connect to listed publishers we lack, drop those no longer listed (idempotent)."""
+        with self.lock:
+            if self.closed:
+                return
+            wanted = [u for u in dict.fromkeys(uris) if u != self.runtime.uri]
+            gone = [u for u in self.connections if u not in wanted]
+            for uri in gone:
+                self.connections.pop(uri).close()
+            new = []
+            for uri in wanted:
+                if uri not in self.connections:
+                    conn = InConnection(self, uri)
+                    self.connections[uri] = conn
+                    new.append(conn)
+        for conn in new:
+            conn.start()
+
+    def num_connections(self) -> int:
+        with self.lock:
+            return sum(1 for c in self.connections.values() if c.connected)
+
+    def close(self) -> None:
+        with self.lock:
+            self.closed = True
+            conns = list(self.connections.values())
+            self.connections.clear()
+        for conn in conns:
+            conn.close()
+
+
+class Subscriber:
+    """Call ``callback(msg)`` (or ``callback(msg, callback_args)``) for each message on
+    ``topic``, from a receive thread. ``queue_size`` is accepted for rospy compatibility."""
+
+    def __init__(self, topic: str, msg_class: type[Message], callback: Callable | None = None,
+                 callback_args: Any = None, queue_size: int | None = 10, **_ignored: Any):
+        from orchestra.node.runtime import get_runtime
+
+        if not (isinstance(msg_class, type) and issubclass(msg_class, Message)):
+            raise ValueError(f"Subscriber needs a message class, not {msg_class!r}")
+        self._rt = get_runtime()
+        self.resolved_name = self.name = self._rt.resolve_name(topic)
+        self.data_class = msg_class
+        self.type = msg_class._type
+        self.callback = callback
+        self.callback_args = callback_args
+        self._impl = self._rt.topics.acquire_subscription(self.name, msg_class)
+        if callback is not None:
+            self._impl.add_callback(callback, callback_args)
+        self._done = False
+
+    def get_num_connections(self) -> int:
+        return self._impl.num_connections()
+
+    def unregister(self) -> None:
+        if not self._done:
+            self._done = True
+            self._rt.topics.release_subscription(self._impl, self.callback, self.callback_args)
+
+
+# --- the per-node table -----------------------------------------------------------------------
+
+class TopicManager:
+    """This node's publications and subscriptions, and their master registrations."""
+
+    def __init__(self, runtime: "NodeRuntime"):
+        self.rt = runtime
+        self.lock = threading.RLock()
+        self.publications: dict[str, Publication] = {}
+        self.subscriptions: dict[str, Subscription] = {}
+
+    def acquire_publication(self, topic: str, msg_class: type[Message], latch: bool,
+                            queue_size: int | None) -> Publication:
+        with self.lock:
+            pub = self.publications.get(topic)
+            if pub is not None:
+                if pub.msg_class._md5sum != msg_class._md5sum:
+                    raise ROSException(f"{topic} is already published here as {pub.type}, "
+                                       f"cannot also publish {msg_class._type}")
+                pub.latch = pub.latch or latch
+                pub.handles += 1
+                return pub
+            pub = Publication(self.rt, topic, msg_class, latch, queue_size)
+            pub.handles = 1
+            self.publications[topic] = pub
+        self.rt.master_register("registerPublisher", topic, msg_class._type)
+        return pub
+
+    def release_publication(self, pub: Publication) -> None:
+        with self.lock:
+            pub.handles -= 1
+            if pub.handles > 0 or self.publications.get(pub.topic) is not pub:
+                return
+            del self.publications[pub.topic]
+        self.rt.master_unregister("unregisterPublisher", pub.topic)
+        pub.close()
+
+    def acquire_subscription(self, topic: str, msg_class: type[Message]) -> Subscription:
+        with self.lock:
+            sub = self.subscriptions.get(topic)
+            if sub is not None:
+                if not md5_compatible(sub.msg_class._md5sum, msg_class._md5sum):
+                    raise ROSException(f"{topic} is already subscribed here as {sub.type}, "
+                                       f"cannot also subscribe as {msg_class._type}")
+                return sub
+            sub = Subscription(self.rt, topic, msg_class)
+            self.subscriptions[topic] = sub
+        publishers = self.rt.master_register("registerSubscriber", topic, msg_class._type)
+        sub.update_publishers(list(publishers or []))
+        return sub
+
+    def release_subscription(self, sub: Subscription, cb: Callable | None, args: Any) -> None:
+        with self.lock:
+            remaining = sub.remove_callback(cb, args) if cb is not None else len(sub.callbacks)
+            if remaining > 0 or self.subscriptions.get(sub.topic) is not sub:
+                return
+            del self.subscriptions[sub.topic]
+        self.rt.master_unregister("unregisterSubscriber", sub.topic)
+        sub.close()
+
+    def publisher_update(self, topic: str, uris: list[str]) -> None:
+        with self.lock:
+            sub = self.subscriptions.get(topic)
+        if sub is not None:
+            sub.update_publishers(uris)
+
+    def has_publication(self, topic: str) -> bool:
+        with self.lock:
+            return topic in self.publications
+
+    def publication_list(self) -> list[list[str]]:
+        with self.lock:
+            return [[t, p.type] for t, p in self.publications.items()]
+
+    def subscription_list(self) -> list[list[str]]:
+        with self.lock:
+            return [[t, s.type] for t, s in self.subscriptions.items()]
+
+    def handle_subscriber(self, sock: socket.socket, header: dict[str, str]) -> None:
+        """A subscriber connected to our TCPROS port asking for ``header['topic']``."""
+        topic = header.get("topic", "")
+        with self.lock:
+            pub = self.publications.get(topic)
+        caller = header.get("callerid", "?")
+        if pub is None:
+            _refuse(sock, f"no topic [{topic}] published by {self.rt.name}",
+                    f"{caller} asked for {topic}, which this node does not publish")
+            return
+        their_md5 = header.get("md5sum", "")
+        cls = pub.msg_class
+        if not md5_compatible(their_md5, cls._md5sum):
+            _refuse(sock, f"Client [{caller}] wants topic {topic} to have datatype/md5sum "
+                          f"[{header.get('type')}/{their_md5}], but our version has "
+                          f"[{cls._type}/{cls._md5sum}]. Dropping connection.",
+                    f"refused subscriber {caller} on {topic}: it expects "
+                    f"{header.get('type')} ({their_md5}), we publish {cls._type} ({cls._md5sum})")
+            return
+        tcpros.write_header(sock, {
+            "callerid": self.rt.name, "topic": topic, "md5sum": cls._md5sum, "type": cls._type,
+            "message_definition": cls._full_text, "latching": "1" if pub.latch else "0"})
+        pub.add_connection(sock, header)
+
+    def close_all(self) -> None:
+        with self.lock:
+            pubs = list(self.publications.values())
+            subs = list(self.subscriptions.values())
+            self.publications.clear()
+            self.subscriptions.clear()
+        for pub in pubs:
+            self.rt.master_unregister("unregisterPublisher", pub.topic)
+        for sub in subs:
+            self.rt.master_unregister("unregisterSubscriber", sub.topic)
+        for item in pubs + subs:
+            item.close()
+
+    def bus_stats(self) -> tuple[list, list]:
+        pubs, subs = [], []
+        with self.lock:
+            for topic, pub in self.publications.items():
+                conns = [[c.id, c.bytes_sent, c.messages_sent, not c.closed]
+                         for c in list(pub.connections)]
+                pubs.append([topic, pub.messages, conns])
+            for topic, sub in self.subscriptions.items():
+                conns = [[c.id, c.bytes_received, c.drops, c.connected]
+                         for c in list(sub.connections.values())]
+                subs.append([topic, conns])
+        return pubs, subs
+
+    def bus_info(self) -> list:
+        info = []
+        with self.lock:
+            for topic, pub in self.publications.items():
+                for c in list(pub.connections):
+                    info.append([c.id, c.peer, "o", "TCPROS", topic, True, ""])
+            for topic, sub in self.subscriptions.items():
+                for c in list(sub.connections.values()):
+                    info.append([c.id, c.uri, "i", "TCPROS", topic, c.connected, ""])
+        return info
+
+
+def _refuse(sock: socket.socket, error: str, reason: str) -> None:
+    """Answer a connection with an ``error`` header, log why, and close it."""
+    log.warning("%s", reason)
+    try:
+        tcpros.write_header(sock, {"error": error})
+    except OSError:
+        pass
+    finally:
+        sock.close()
+
+
+def wait_until(predicate: Callable[[], bool], timeout: float | None, interval: float = 0.01) -> bool:
+    deadline = None if timeout is None else time.monotonic() + timeout
+    while not predicate():
+        if deadline is not None and time.monotonic() >= deadline:
+            return False
+        time.sleep(interval)
+    return True
