@@ -31,7 +31,7 @@ class Scope:
 
     __slots__ = ("parent", "ns", "filename", "remaps", "params", "env_args", "args",
                  "arg_docs", "arg_names", "include_args", "pass_all_args", "args_passed",
-                 "include_stack")
+                 "include_stack", "pending_filename")
 
     def __init__(self, ns: str, filename: str | None, parent: "Scope | None" = None,
                  params: list[tuple[str, Any]] | None = None,
@@ -55,6 +55,7 @@ class Scope:
         self.pass_all_args = pass_all_args
         self.args_passed: list[str] = []
         self.include_stack = include_stack
+        self.pending_filename: str | None = None
 
     # ------------------------------------------------------------------ children
     def child(self, ns: str | None) -> "Scope":
@@ -81,7 +82,9 @@ class Scope:
         """The scope an ``<include>`` tag's own ``<arg>``/``<env>`` children are read in."""
         scope = self.child(ns)
         scope.arg_names = []
-        scope.filename = filename
+        # the <include>'s own children still resolve $(dirname) against the including file;
+        # the included file's name takes over in enter_include()
+        scope.pending_filename = filename
         scope.include_args = {}
         return scope
 
@@ -137,6 +140,9 @@ class Scope:
             if name not in passed:
                 raise ScopeError(f"include arg '{name}' must have a value")
         self.args_passed = list(passed)
+        if self.pending_filename is not None:
+            self.filename = self.pending_filename
+            self.pending_filename = None
         self.arg_names = []
         self.args = passed
         self.arg_docs = {}
