@@ -36,9 +36,10 @@ class DependencyGraph:
     def transitive(self, name: str) -> list[str]:
         """All dependencies of ``name``, each after everything it depends on (build order)."""
         reachable = nx.descendants(self.graph, name)
-        sub = self.graph.subgraph(reachable)
+        sub = self.graph.subgraph(reachable | {name})
         try:
-            return list(nx.lexicographical_topological_sort(sub.reverse(copy=True)))
+            order = list(nx.lexicographical_topological_sort(sub.reverse(copy=True)))
+            return [n for n in order if n != name]
         except nx.NetworkXUnfeasible:
             cycle = nx.find_cycle(sub)
             chain = " -> ".join([edge[0] for edge in cycle] + [cycle[0][0]])
