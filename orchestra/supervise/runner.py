@@ -1,0 +1,319 @@
+"""``orchestra launch`` at run time: plan -> master + params -> supervised processes.
+
+The order matters for "nothing half-started": everything that can be the user's fault
+(unknown executables, remote machines, bad args) is checked before the master is touched
+or any process is spawned. Then, like roslaunch: use the master at ROS_MASTER_URI when one
+answers (or wait for it with ``--wait``), else start the embedded one; set /run_id, clear
+and upload the parameters, and start the nodes.
+"""
+from __future__ import annotations
+
+import logging
+import os
+import socket
+import sys
+import time
+import urllib.parse
+import uuid
+import xmlrpc.client
+from dataclasses import dataclass, field
+from typing import Any, Mapping
+
+import click
+
+from orchestra.errors import Location, OrchestraError
+from orchestra.launch.plan import LaunchPlan, Node
+from orchestra.supervise.command import find_node_executable, node_argv, node_cwd, node_env
+from orchestra.supervise.output import Screen, prepare_run_log_dir
+from orchestra.supervise.process import OutputMode, ProcessSpec, RestartPolicy
+
+logger = logging.getLogger(__name__)
+
+LOCAL_NAMES = {"localhost", "127.0.0.1", "::1", "localhost.localdomain", "ip6-localhost"}
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """The run-time flags of ``orchestra launch`` (see cli.run_options for their help)."""
+
+    force_screen: bool = False
+    force_log: bool = False
+    wait: bool = False
+    all_required: bool = False
+    local: bool = False
+    disable_title: bool = False
+    port: int | None = None
+    run_id: str | None = None
+    sigint_timeout: float = 15.0
+    sigterm_timeout: float = 2.0
+    node_timeouts: Mapping[str, tuple[float | None, float | None]] = field(default_factory=dict)
+    backoff_max: float = 30.0
+    crash_limit: int = 10
+    log_max_bytes: int = 0
+    log_backups: int = 5
+    status_view: bool | None = None
+    with_tests: bool = False
+
+    @classmethod
+    def from_kwargs(cls, options: Mapping[str, Any]) -> "RunOptions":
+        known = {f for f in cls.__dataclass_fields__}
+        values = {k: v for k, v in options.items() if k in known and v is not None}
+        if "node_timeouts" in values and not isinstance(values["node_timeouts"], Mapping):
+            values["node_timeouts"] = parse_node_timeouts(values["node_timeouts"])
+        return cls(**values)
+
+
+def parse_node_timeouts(items: Any) -> dict[str, tuple[float | None, float | None]]:
+    """``/node=SIGINT[,SIGTERM]`` words -> {"/node": (sigint, sigterm)}."""
+    result: dict[str, tuple[float | None, float | None]] = {}
+    for item in items or ():
+        name, sep, spec = str(item).partition("=")
+        parts = spec.split(",")
+        try:
+            if not sep or not name or len(parts) > 2:
+                raise ValueError
+            sigint = float(parts[0]) if parts[0] else None
+            sigterm = float(parts[1]) if len(parts) > 1 and parts[1] else None
+            if (sigint is not None and sigint < 0) or (sigterm is not None and sigterm < 0):
+                raise ValueError
+        except ValueError:
+            raise OrchestraError(f"--node-timeout {item!r}: expected NODE=SIGINT_SECONDS"
+                                 "[,SIGTERM_SECONDS], e.g. /camera=30,5") from None
+        result[name if name.startswith("/") else "/" + name] = (sigint, sigterm)
+    return result
+
+
+def parse_size(text: str | int | None) -> int:
+    """``100M`` / ``512K`` / ``1G`` / bytes -> bytes (0 = no rotation)."""
+    if text is None:
+        return 0
+    if isinstance(text, int):
+        return text
+    value = text.strip().upper()
+    scale = 1
+    if value and value[-1] in "KMG":
+        scale = 1024 ** ("KMG".index(value[-1]) + 1)
+        value = value[:-1]
+    try:
+        size = int(float(value) * scale)
+    except ValueError:
+        raise OrchestraError(f"--log-max-size {text!r}: expected a size like 100M") from None
+    if size < 0:
+        raise OrchestraError(f"--log-max-size {text!r}: must not be negative")
+    return size
+
+
+def _location(node: Node) -> Location | None:
+    return Location(node.filename, node.line) if node.filename else None
+
+
+def is_local_address(address: str) -> bool:
+    """True when ``address`` names this machine (roslaunch runs such machines' nodes locally)."""
+    if not address or address in LOCAL_NAMES or address.startswith("127."):
+        return True
+    if address in (socket.gethostname(), socket.getfqdn()):
+        return True
+    try:
+        resolved = {info[4][0] for info in socket.getaddrinfo(address, None)}
+    except OSError:
+        return False
+    try:
+        import psutil
+
+        mine = {a.address for addrs in psutil.net_if_addrs().values() for a in addrs}
+    except Exception:  # noqa: BLE001 - best effort only
+        mine = set()
+    return bool(resolved & (mine | {"127.0.0.1", "::1"}))
+
+
+def _check_machines(plan: LaunchPlan, nodes: list[Node], local: bool) -> None:
+    if local:
+        return
+    for node in nodes:
+        machine = plan.machines.get(node.machine_name or "")
+        if machine is not None and node.machine_name and not is_local_address(machine.address):
+            raise OrchestraError(
+                f"node '{node.full_name}' runs on machine '{machine.name}' "
+                f"({machine.address}); orchestra does not start nodes over ssh: run orchestra "
+                "on that machine, or pass --local to run every node here", _location(node))
+
+
+def resolve_executables(nodes: list[Node]) -> dict[str, str]:
+    """Full name -> executable for every node; ALL problems reported before anything starts."""
+    found: dict[str, str] = {}
+    errors: list[OrchestraError] = []
+    for node in nodes:
+        try:
+            found[node.full_name] = find_node_executable(node)
+        except OrchestraError as exc:
+            errors.append(exc)
+    if errors:
+        first = errors[0]
+        more = f" (and {len(errors) - 1} more node(s) like it)" if len(errors) > 1 else ""
+        raise OrchestraError(first.message + more, first.location)
+    return found
+
+
+def log_base_name(full_name: str, counter: int) -> str:
+    """roslaunch's per-process name for log files: ``robot1-listener-3``."""
+    return f"{full_name.lstrip('/').replace('/', '-')}-{counter}"
+
+
+def output_mode(node: Node, options: RunOptions) -> OutputMode:
+    if options.force_screen:
+        return OutputMode.SCREEN
+    if options.force_log:
+        return OutputMode.LOG
+    if node.output == "screen":
+        return OutputMode.SCREEN
+    if node.output == "both":
+        return OutputMode.BOTH
+    return OutputMode.LOG
+
+
+def build_specs(nodes: list[Node], executables: Mapping[str, str], master_uri: str,
+                run_dir: str, options: RunOptions,
+                environ: Mapping[str, str] | None = None) -> list[ProcessSpec]:
+    """The ProcessSpec of each node: exactly roslaunch's argv/env/cwd plus our run settings."""
+    base = dict(os.environ if environ is None else environ)
+    # nodes write to pipes, not a TTY: without this, Python nodes block-buffer their output
+    # and the console shows it late (roslaunch leaves screen nodes on the TTY instead)
+    base.setdefault("PYTHONUNBUFFERED", "1")
+    specs = []
+    for counter, node in enumerate(nodes, start=1):
+        exe = executables[node.full_name]
+        log_name = log_base_name(node.full_name, counter)
+        argv = node_argv(node, exe, log_file=os.path.join(run_dir, log_name + ".log"))
+        env = dict(base)
+        env.update(node_env(node, master_uri))
+        sigint, sigterm = options.node_timeouts.get(node.full_name, (None, None))
+        specs.append(ProcessSpec(
+            name=node.full_name, argv=tuple(argv), env=env,
+            cwd=node_cwd(node, exe, base),
+            respawn=node.respawn, respawn_delay=node.respawn_delay,
+            required=node.required or options.all_required,
+            output=output_mode(node, options), log_name=log_name,
+            sigint_timeout=options.sigint_timeout if sigint is None else sigint,
+            sigterm_timeout=options.sigterm_timeout if sigterm is None else sigterm,
+            location=str(_location(node)) if node.filename else None))
+    return specs
+
+
+@dataclass
+class MasterConnection:
+    uri: str
+    handle: Any = None           # the embedded master, when we started it
+    run_id: str = ""
+
+    def close(self) -> None:
+        if self.handle is not None:
+            self.handle.shutdown("launch ended")
+
+
+def _existing_run_id(uri: str) -> str | None:
+    try:
+        code, _, value = xmlrpc.client.ServerProxy(uri).getParam("/roslaunch", "/run_id")
+    except Exception:  # noqa: BLE001 - a master without /run_id is fine
+        return None
+    return value if code == 1 and isinstance(value, str) else None
+
+
+def connect_master(options: RunOptions, echo) -> MasterConnection:
+    """Use the master at ROS_MASTER_URI if it answers, wait for it (--wait), or embed one."""
+    from orchestra.master import master_is_up, master_uri_from_env, port_from_uri, start_master
+
+    uri = master_uri_from_env()
+    if options.port is not None:
+        parts = urllib.parse.urlsplit(uri)
+        uri = f"http://{parts.hostname or 'localhost'}:{options.port}/"
+    if master_is_up(uri):
+        run_id = _existing_run_id(uri) or options.run_id or str(uuid.uuid1())
+        return MasterConnection(uri, None, run_id)
+    if options.wait:
+        echo(f"waiting for the master at {uri} ...")
+        while not master_is_up(uri):
+            time.sleep(0.2)
+        run_id = _existing_run_id(uri) or options.run_id or str(uuid.uuid1())
+        return MasterConnection(uri, None, run_id)
+    host = urllib.parse.urlsplit(uri).hostname or "localhost"
+    bind = "127.0.0.1" if host in LOCAL_NAMES or host.startswith("127.") else "0.0.0.0"
+    handle = start_master(bind, port_from_uri(uri), advertise=host)
+    echo(f"started embedded master at {handle.uri}")
+    return MasterConnection(handle.uri, handle, options.run_id or str(uuid.uuid1()))
+
+
+def upload(plan: LaunchPlan, master: MasterConnection) -> None:
+    from orchestra.master import core_params, upload_params
+
+    params: dict[str, Any] = {}
+    if master.handle is not None:
+        params.update(core_params(master.run_id))
+    params.update(plan.params)
+    params["/run_id"] = master.run_id
+    upload_params(master.uri, params, list(plan.clear_params))
+
+
+def _set_title(title: str) -> None:
+    if sys.stdout.isatty():
+        sys.stdout.write(f"\x1b]2;{title}\x07")
+        sys.stdout.flush()
+
+
+def run_plan(plan: LaunchPlan, options: Mapping[str, Any]) -> int:
+    """Run the plan's nodes under supervision until stopped; returns orchestra's exit code."""
+    from orchestra.supervise.reaper import Watchdog
+    from orchestra.supervise.status import LiveView, ProcessStats, StatusServer, snapshot
+    from orchestra.supervise.supervisor import Supervisor
+
+    opts = RunOptions.from_kwargs(options)
+    nodes = list(plan.nodes) + (list(plan.tests) if opts.with_tests else [])
+    # --- everything that may be the user's fault, before anything starts
+    _check_machines(plan, nodes, opts.local)
+    executables = resolve_executables(nodes)
+
+    def echo(text: str) -> None:
+        click.echo(text, err=True)
+
+    watchdog = Watchdog()  # forked first: it must not inherit the master's socket
+    master = None
+    try:
+        master = connect_master(opts, echo)
+        run_dir = prepare_run_log_dir(master.run_id)
+        upload(plan, master)
+        specs = build_specs(nodes, executables, master.uri, run_dir, opts)
+        screen = Screen()
+        if not opts.disable_title and plan.files_loaded:
+            _set_title(" ".join(plan.files_loaded[:1]) + f" {master.uri}")
+        echo(f"logging to {run_dir}")
+        supervisor = Supervisor(specs, RestartPolicy(backoff_max=opts.backoff_max,
+                                                     crash_limit=opts.crash_limit),
+                                screen=screen, log_dir=run_dir, watchdog=watchdog,
+                                log_max_bytes=opts.log_max_bytes, log_backups=opts.log_backups)
+        stats = ProcessStats()
+        info = {"run_id": master.run_id, "master_uri": master.uri,
+                "launch_files": list(plan.files_loaded), "log_dir": run_dir}
+
+        def make_snapshot() -> dict[str, Any]:
+            return snapshot(supervisor.procs, stats, info)
+
+        server = StatusServer(supervisor.loop, make_snapshot)
+        view_on = opts.status_view if opts.status_view is not None else screen.out.isatty()
+        view = LiveView(supervisor.loop, screen, make_snapshot) if view_on else None
+        if view is not None:
+            supervisor.on_change = view.changed
+            supervisor.loop.call_later(0, view.start)
+        try:
+            result = supervisor.run()
+        finally:
+            if view is not None:
+                view.close()
+            server.close()
+    finally:
+        if master is not None:
+            master.close()
+        watchdog.close()
+    if result.exit_code != 0:
+        echo(f"orchestra: error: {result.reason}")
+    else:
+        echo(f"orchestra: {result.reason}; all processes stopped")
+    return result.exit_code

@@ -1,0 +1,255 @@
+"""What a running launch reports about its nodes: the snapshot, the table, the status socket.
+
+A running ``orchestra launch`` serves its snapshot as one JSON document on a Unix socket in
+a per-user runtime directory (``$XDG_RUNTIME_DIR/orchestra`` or ``/tmp/orchestra-<uid>``),
+named after its pid. ``orchestra status`` connects to every socket there, so it needs
+neither a master nor a port, and one user cannot read another's launches.
+"""
+from __future__ import annotations
+
+import json
+import os
+import socket
+import stat
+from typing import Any, Callable
+
+import psutil
+
+from orchestra.supervise.loop import EventLoop
+from orchestra.supervise.process import ManagedProcess, State
+
+SNAPSHOT_VERSION = 1
+
+
+def runtime_dir(environ: dict[str, str] | None = None) -> str:
+    """The per-user directory holding the status sockets (created 0700 when missing)."""
+    env = os.environ if environ is None else environ
+    base = env.get("XDG_RUNTIME_DIR")
+    if base and os.path.isdir(base) and os.access(base, os.W_OK):
+        path = os.path.join(base, "orchestra")
+    else:
+        path = os.path.join("/tmp", f"orchestra-{os.getuid()}")
+    os.makedirs(path, mode=0o700, exist_ok=True)
+    return path
+
+
+class ProcessStats:
+    """CPU% and RSS per pid, keeping psutil handles so CPU% is measured between two calls."""
+
+    def __init__(self) -> None:
+        self._handles: dict[int, psutil.Process] = {}
+
+    def sample(self, pid: int | None) -> tuple[float | None, int | None]:
+        if pid is None:
+            return None, None
+        handle = self._handles.get(pid)
+        try:
+            if handle is None:
+                handle = self._handles[pid] = psutil.Process(pid)
+            with handle.oneshot():
+                return handle.cpu_percent(None), handle.memory_info().rss
+        except (psutil.NoSuchProcess, psutil.AccessDenied, psutil.ZombieProcess):
+            self._handles.pop(pid, None)
+            return None, None
+
+    def forget_except(self, pids: set[int]) -> None:
+        for pid in list(self._handles):
+            if pid not in pids:
+                del self._handles[pid]
+
+
+def node_status(proc: ManagedProcess, stats: ProcessStats) -> dict[str, Any]:
+    live = proc.state in (State.RUNNING, State.STOPPING)
+    cpu, rss = stats.sample(proc.pid) if live else (None, None)
+    return {
+        "name": proc.spec.name,
+        "state": proc.state.value,
+        "pid": proc.pid if live else None,
+        "restarts": proc.restarts,
+        "uptime": round(proc.uptime, 3),
+        "cpu_percent": cpu,
+        "rss": rss,
+        "exit_code": proc.exit_code,
+        "required": proc.spec.required,
+        "respawn": proc.spec.respawn,
+        "reason": proc.reason,
+    }
+
+
+def snapshot(procs: list[ManagedProcess], stats: ProcessStats, info: dict[str, Any]) -> dict[str, Any]:
+    """The JSON document ``orchestra status --json`` prints for one launch."""
+    nodes = [node_status(p, stats) for p in procs]
+    stats.forget_except({n["pid"] for n in nodes if n["pid"] is not None})
+    return {"version": SNAPSHOT_VERSION, "pid": os.getpid(), **info, "nodes": nodes}
+
+
+def _duration(seconds: float) -> str:
+    seconds = int(seconds)
+    if seconds < 60:
+        return f"{seconds}s"
+    if seconds < 3600:
+        return f"{seconds // 60}m{seconds % 60:02d}s"
+    return f"{seconds // 3600}h{seconds // 60 % 60:02d}m"
+
+
+def _size(rss: int | None) -> str:
+    if rss is None:
+        return "-"
+    for unit in ("B", "K", "M", "G"):
+        if rss < 1024 or unit == "G":
+            return f"{rss:.0f}{unit}" if unit == "B" else f"{rss:.1f}{unit}"
+        rss /= 1024
+    return "-"
+
+
+def table_lines(nodes: list[dict[str, Any]]) -> list[str]:
+    """One compact line per node: name, state, pid, restarts, uptime, CPU%, RSS."""
+    width = max([len("NODE")] + [len(n["name"]) for n in nodes])
+    lines = [f"{'NODE':<{width}}  {'STATE':<8} {'PID':>7} {'RESTARTS':>8} {'UPTIME':>8} "
+             f"{'CPU%':>6} {'RSS':>7}"]
+    for n in nodes:
+        cpu = "-" if n["cpu_percent"] is None else f"{n['cpu_percent']:.1f}"
+        pid = "-" if n["pid"] is None else str(n["pid"])
+        uptime = _duration(n["uptime"]) if n["pid"] is not None else "-"
+        lines.append(f"{n['name']:<{width}}  {n['state']:<8} {pid:>7} {n['restarts']:>8} "
+                     f"{uptime:>8} {cpu:>6} {_size(n['rss']):>7}")
+    return lines
+
+
+def summary_line(nodes: list[dict[str, Any]]) -> str:
+    counts: dict[str, int] = {}
+    for n in nodes:
+        counts[n["state"]] = counts.get(n["state"], 0) + 1
+    parts = [f"{counts[s.value]} {s.value}" for s in State if s.value in counts]
+    return f"{len(nodes)} nodes: " + ", ".join(parts)
+
+
+def footer_lines(nodes: list[dict[str, Any]], max_lines: int) -> list[str]:
+    """The live view: the full table when it fits, else a summary plus the unhealthy nodes."""
+    if len(nodes) + 1 <= max_lines:
+        return table_lines(nodes)
+    unhealthy = [n for n in nodes if n["state"] != State.RUNNING.value]
+    shown = table_lines(unhealthy[:max(0, max_lines - 2)]) if unhealthy else []
+    return [summary_line(nodes)] + shown
+
+
+class StatusServer:
+    """Serves ``snapshot()`` on a Unix socket from the supervisor's own loop (no thread)."""
+
+    def __init__(self, loop: EventLoop, make_snapshot: Callable[[], dict[str, Any]],
+                 path: str | None = None):
+        self.path = path or os.path.join(runtime_dir(), f"{os.getpid()}.sock")
+        if os.path.exists(self.path):
+            os.unlink(self.path)
+        self._sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+        self._sock.bind(self.path)
+        os.chmod(self.path, stat.S_IRUSR | stat.S_IWUSR)
+        self._sock.listen(8)
+        self._sock.setblocking(False)
+        self._loop = loop
+        self._make = make_snapshot
+        loop.add_reader(self._sock.fileno(), self._accept)
+
+    def _accept(self) -> None:
+        try:
+            conn, _ = self._sock.accept()
+        except (BlockingIOError, OSError):
+            return
+        with conn:
+            conn.settimeout(1.0)
+            try:
+                conn.sendall(json.dumps(self._make()).encode() + b"\n")
+            except OSError:
+                pass
+
+    def close(self) -> None:
+        self._loop.remove_reader(self._sock.fileno())
+        self._sock.close()
+        try:
+            os.unlink(self.path)
+        except OSError:
+            pass
+
+
+def query(path: str, timeout: float = 3.0) -> dict[str, Any]:
+    """Ask the launch behind socket ``path`` for its snapshot (OSError when it is gone)."""
+    with socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as sock:
+        sock.settimeout(timeout)
+        sock.connect(path)
+        chunks = []
+        while True:
+            data = sock.recv(65536)
+            if not data:
+                break
+            chunks.append(data)
+    return json.loads(b"".join(chunks))
+
+
+def running_launches(directory: str | None = None) -> list[dict[str, Any]]:
+    """Snapshots of every launch of this user that answers; stale sockets are removed."""
+    directory = directory or runtime_dir()
+    found = []
+    for name in sorted(os.listdir(directory)):
+        if not name.endswith(".sock"):
+            continue
+        path = os.path.join(directory, name)
+        try:
+            found.append(query(path))
+        except (ConnectionRefusedError, FileNotFoundError):
+            pid = name[:-5]
+            if pid.isdigit() and not psutil.pid_exists(int(pid)):
+                try:
+                    os.unlink(path)
+                except OSError:
+                    pass
+        except (OSError, ValueError):
+            continue
+    return found
+
+
+class LiveView:
+    """Redraws the status table under the scrolling node output on a TTY, once a second."""
+
+    def __init__(self, loop: EventLoop, screen, make_snapshot: Callable[[], dict[str, Any]],
+                 interval: float = 1.0):
+        self._loop = loop
+        self._screen = screen
+        self._make = make_snapshot
+        self._interval = interval
+        self._timer = None
+        self._pending = None
+        self._closed = False
+
+    def start(self) -> None:
+        self._tick()
+
+    def _max_lines(self) -> int:
+        try:
+            rows = os.get_terminal_size().lines
+        except OSError:
+            rows = 24
+        return max(3, rows // 3)
+
+    def changed(self) -> None:
+        """A state changed: redraw soon, once for a burst of changes (100 nodes starting)."""
+        if self._pending is None and not self._closed:
+            self._pending = self._loop.call_later(0.1, self.refresh)
+
+    def refresh(self) -> None:
+        if self._pending is not None:
+            self._pending.cancel()
+            self._pending = None
+        if not self._closed:
+            self._screen.set_footer(footer_lines(self._make()["nodes"], self._max_lines()))
+
+    def _tick(self) -> None:
+        self.refresh()
+        if not self._closed:
+            self._timer = self._loop.call_later(self._interval, self._tick)
+
+    def close(self) -> None:
+        self._closed = True
+        for timer in (self._timer, self._pending):
+            if timer is not None:
+                timer.cancel()
+        self._screen.set_footer([])
