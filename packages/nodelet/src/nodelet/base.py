@@ -1,0 +1,137 @@
+"""The ``Nodelet`` base class: a node that runs inside a manager process.
+
+A nodelet gets its identity (name, remappings, argv) from whoever loads it, not from the
+process, so every topic/param/service name it uses goes through ``resolve`` against that
+identity and reaches ``orchestra.node`` as a global name. Everything it creates is
+remembered so ``shutdown`` (unload) removes exactly this nodelet's traffic and timers and
+leaves the manager and its other nodelets running.
+"""
+from __future__ import annotations
+
+import logging
+import threading
+from typing import Any, Callable
+
+from nodelet import names
+
+_MISSING = object()
+
+
+class Timer:
+    """Calls ``callback(now_seconds)`` every ``period`` seconds on its own thread until stopped."""
+
+    def __init__(self, period: float, callback: Callable[[float], None], name: str):
+        self.period = period
+        self.callback = callback
+        self._stop = threading.Event()
+        self._log = logging.getLogger(name)
+        self._thread = threading.Thread(target=self._run, name=f"timer:{name}", daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        import time
+        next_time = time.monotonic()
+        while not self._stop.is_set():
+            next_time += self.period
+            try:
+                self.callback(time.time())
+            except Exception:  # a faulty callback must not kill the manager's other nodelets
+                self._log.exception("timer callback failed")
+            delay = next_time - time.monotonic()
+            if delay < 0:  # fell behind: do not try to catch up in a burst
+                next_time = time.monotonic()
+                delay = 0
+            self._stop.wait(delay)
+
+    def shutdown(self) -> None:
+        self._stop.set()
+
+
+class Nodelet:
+    """Subclass and override ``on_init`` (roscpp's ``onInit``): create publishers,
+    subscribers, services and timers there through the helpers below."""
+
+    def __init__(self, name: str, remaps: dict[str, str] | None = None,
+                 my_argv: list[str] | None = None):
+        self.name = names.canonicalize(name)
+        self.namespace = names.namespace_of(self.name)
+        self.remaps = dict(remaps or {})
+        self.my_argv = list(my_argv or [])
+        self.log = logging.getLogger(self.name)
+        self._handles: list[Any] = []
+        self._timers: list[Timer] = []
+        self._lock = threading.Lock()
+        self._shut_down = False
+
+    # ---- to override -------------------------------------------------------------------
+    def on_init(self) -> None:
+        """Set the nodelet up; raising here makes the load fail (and the loader exit)."""
+
+    def on_shutdown(self) -> None:
+        """Release what ``on_init`` took beyond publishers/subscribers/services/timers."""
+
+    # ---- names and params --------------------------------------------------------------
+    def resolve(self, name: str) -> str:
+        return names.resolve(name, self.name, self.remaps)
+
+    def get_param(self, name: str, default: Any = _MISSING) -> Any:
+        """A parameter by nodelet-relative name (``~x`` is the nodelet's private one)."""
+        from orchestra import node
+        resolved = names.resolve(name, self.name)
+        if default is _MISSING:
+            return node.get_param(resolved)
+        return node.get_param(resolved, default)
+
+    def get_private_param(self, name: str, default: Any = _MISSING) -> Any:
+        return self.get_param("~" + name, default)
+
+    # ---- graph resources ---------------------------------------------------------------
+    def _keep(self, handle: Any) -> Any:
+        with self._lock:
+            self._handles.append(handle)
+        return handle
+
+    def advertise(self, topic: str, msg_class: type, queue_size: int = 10,
+                  latch: bool = False) -> Any:
+        from orchestra import node
+        return self._keep(node.Publisher(self.resolve(topic), msg_class,
+                                         queue_size=queue_size, latch=latch))
+
+    def subscribe(self, topic: str, msg_class: type, callback: Callable[[Any], None],
+                  queue_size: int = 10) -> Any:
+        from orchestra import node
+        return self._keep(node.Subscriber(self.resolve(topic), msg_class, callback,
+                                          queue_size=queue_size))
+
+    def advertise_service(self, name: str, srv_class: type,
+                          handler: Callable[[Any], Any]) -> Any:
+        from orchestra import node
+        return self._keep(node.Service(self.resolve(name), srv_class, handler))
+
+    def create_timer(self, period: float, callback: Callable[[float], None]) -> Timer:
+        timer = Timer(period, callback, self.name)
+        with self._lock:
+            self._timers.append(timer)
+        return timer
+
+    # ---- lifecycle ---------------------------------------------------------------------
+    def shutdown(self) -> None:
+        """Stop timers first (they publish), then drop every registration. Idempotent."""
+        with self._lock:
+            if self._shut_down:
+                return
+            self._shut_down = True
+            timers, handles = self._timers[:], self._handles[:]
+        for timer in timers:
+            timer.shutdown()
+        try:
+            self.on_shutdown()
+        except Exception:
+            self.log.exception("on_shutdown failed")
+        for handle in reversed(handles):
+            stop = getattr(handle, "unregister", None) or getattr(handle, "shutdown", None)
+            if stop is not None:
+                try:
+                    stop()
+                except Exception:
+                    self.log.debug("unregistering %r failed", handle, exc_info=True)

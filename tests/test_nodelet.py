@@ -1,0 +1,179 @@
+"""nodelet: name resolution for hosted nodelets, plugin discovery, the manager's book-keeping."""
+from __future__ import annotations
+
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+PACKAGES = Path(__file__).resolve().parent.parent / "packages"
+sys.path.insert(0, str(PACKAGES / "nodelet" / "src"))
+
+from nodelet import Nodelet, names  # noqa: E402
+from nodelet.manager import LoadError, Manager  # noqa: E402
+from nodelet.plugins import PluginError, find_declaration, load_plugin  # noqa: E402
+
+
+# ---- names -----------------------------------------------------------------------------
+@pytest.mark.parametrize("name, expected", [
+    ("odom", "/odom"),
+    ("~odom", "/mobile_base/odom"),
+    ("/diagnostics", "/diagnostics"),
+    ("sensors//imu", "/sensors/imu"),
+])
+def test_resolve_against_the_nodelets_own_name(name, expected):
+    assert names.resolve(name, "/mobile_base") == expected
+
+
+def test_resolve_in_a_namespace():
+    assert names.resolve("odom", "/robot1/mobile_base") == "/robot1/odom"
+    assert names.resolve("~odom", "/robot1/mobile_base") == "/robot1/mobile_base/odom"
+
+
+def test_remaps_from_loader_argv_apply_to_resolved_names():
+    remaps = names.parse_remaps(["manager", "mobile_base/odom:=odom", "_param:=1",
+                                 "__name:=mobile_base", "~enable:=/enable"], "/mobile_base")
+    assert remaps == {"/mobile_base/odom": "/odom", "/mobile_base/enable": "/enable"}
+    assert names.resolve("~odom", "/mobile_base", remaps) == "/odom"
+    assert names.resolve("~joint_states", "/mobile_base", remaps) == "/mobile_base/joint_states"
+
+
+def test_strip_ros_args_keeps_plain_words():
+    assert names.strip_ros_args(["load", "a/B", "mgr", "x:=y", "__name:=n"]) == ["load", "a/B", "mgr"]
+
+
+# ---- plugins ---------------------------------------------------------------------------
+def make_plugin_package(root: Path, pkg: str, module: str, body: str,
+                        class_name: str = "Thing", type_name: str | None = None) -> None:
+    directory = root / pkg
+    (directory / "py" / module).mkdir(parents=True)
+    (directory / "package.xml").write_text(textwrap.dedent(f"""\
+        <package format="2"><name>{pkg}</name><version>0.0.0</version>
+          <description>d</description><maintainer email="a@b.c">m</maintainer>
+          <license>BSD</license>
+          <export><nodelet plugin="${{prefix}}/plugins.xml"/></export>
+        </package>"""))
+    (directory / "plugins.xml").write_text(
+        f'<library path="py"><class name="{type_name or pkg + "/" + class_name}" '
+        f'type="{module}.impl:{class_name}" base_class_type="nodelet::Nodelet"/></library>')
+    (directory / "py" / module / "__init__.py").write_text("")
+    (directory / "py" / module / "impl.py").write_text(textwrap.dedent(body))
+
+
+@pytest.fixture
+def workspace(tmp_path, monkeypatch):
+    from orchestra.packages.index import reset_index
+    ws = tmp_path / "ws"
+    ws.mkdir()
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(ws))
+    monkeypatch.setenv("ROS_HOME", str(tmp_path / "ros_home"))
+    reset_index()
+    yield ws
+    reset_index()
+
+
+GOOD = """
+    from nodelet import Nodelet
+    class Thing(Nodelet):
+        def on_init(self):
+            self.started = self.resolve("~out")
+        def on_shutdown(self):
+            self.stopped = True
+"""
+
+
+def test_plugin_declared_in_package_xml_export_is_found_and_imported(workspace, tmp_path):
+    module = f"plug_{tmp_path.name}"
+    make_plugin_package(workspace, "my_pkg", module, GOOD)
+    decl = find_declaration("my_pkg/Thing")
+    assert decl.type == f"{module}.impl:Thing"
+    assert issubclass(load_plugin("my_pkg/Thing"), Nodelet)
+
+
+def test_plugin_exported_by_another_package_is_found(workspace, tmp_path):
+    make_plugin_package(workspace, "provider", f"prov_{tmp_path.name}", GOOD,
+                        type_name="other_name/Thing")
+    assert find_declaration("other_name/Thing").name == "other_name/Thing"
+
+
+def test_unknown_plugin_type_is_a_clear_error(workspace):
+    with pytest.raises(PluginError, match="declared by no package"):
+        find_declaration("nobody/Nothing")
+
+
+def test_plugin_class_missing_from_module_names_the_description_file(workspace, tmp_path):
+    make_plugin_package(workspace, "broken", f"brk_{tmp_path.name}", "X = 1\n")
+    with pytest.raises(PluginError, match="has no class 'Thing'") as info:
+        load_plugin("broken/Thing")
+    assert "plugins.xml" in str(info.value)
+
+
+def test_bundled_turtlebot_nodelets_are_declared():
+    assert find_declaration("kobuki_node/KobukiNodelet").type == "kobuki_node.nodelet:KobukiNodelet"
+    assert find_declaration("yocs_cmd_vel_mux/CmdVelMuxNodelet").name.startswith("yocs")
+
+
+# ---- manager ---------------------------------------------------------------------------
+def test_manager_loads_with_identity_and_unloads(workspace, tmp_path):
+    make_plugin_package(workspace, "my_pkg", f"mgr_{tmp_path.name}", GOOD)
+    manager = Manager()
+    instance = manager.load("/ns/thing", "my_pkg/Thing", {"/ns/thing/out": "/elsewhere"}, ["a"])
+    assert instance.started == "/elsewhere"
+    assert instance.namespace == "/ns" and instance.my_argv == ["a"]
+    assert manager.list() == ["/ns/thing"]
+    assert manager.unload("/ns/thing") is True
+    assert instance.stopped is True
+    assert manager.list() == [] and manager.unload("/ns/thing") is False
+
+
+def test_manager_refuses_a_second_nodelet_with_the_same_name(workspace, tmp_path):
+    make_plugin_package(workspace, "my_pkg", f"dup_{tmp_path.name}", GOOD)
+    manager = Manager()
+    manager.load("/thing", "my_pkg/Thing", {}, [])
+    with pytest.raises(LoadError, match="already loaded"):
+        manager.load("/thing", "my_pkg/Thing", {}, [])
+    assert manager.list() == ["/thing"]
+
+
+def test_failing_on_init_leaves_nothing_loaded(workspace, tmp_path):
+    make_plugin_package(workspace, "bad_init", f"bad_{tmp_path.name}", """
+        from nodelet import Nodelet
+        class Thing(Nodelet):
+            def on_init(self):
+                raise RuntimeError("no device")
+    """)
+    manager = Manager()
+    with pytest.raises(LoadError, match="no device"):
+        manager.load("/thing", "bad_init/Thing", {}, [])
+    assert manager.list() == []
+
+
+def test_class_that_is_not_a_nodelet_is_refused(workspace, tmp_path):
+    make_plugin_package(workspace, "plain", f"plain_{tmp_path.name}", "class Thing:\n    pass\n")
+    with pytest.raises(LoadError, match="not a nodelet"):
+        Manager().load("/thing", "plain/Thing", {}, [])
+
+
+def test_unknown_type_is_a_load_error_not_a_crash(workspace):
+    with pytest.raises(LoadError, match="declared by no package"):
+        Manager().load("/thing", "nobody/Nothing", {}, [])
+
+
+def test_shutdown_stops_timers_and_is_idempotent():
+    import threading
+    ticks = []
+    event = threading.Event()
+
+    class Ticker(Nodelet):
+        def on_init(self):
+            self.create_timer(0.01, lambda now: (ticks.append(now), event.set()))
+
+    ticker = Ticker("/ticker")
+    ticker.on_init()
+    assert event.wait(2.0)
+    ticker.shutdown()
+    ticker.shutdown()
+    count = len(ticks)
+    threading.Event().wait(0.05)
+    assert len(ticks) <= count + 1
