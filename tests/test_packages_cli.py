@@ -1,0 +1,189 @@
+"""find_executable (roslaunch/rosrun rules) and the `pkg` / `run` commands."""
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+from orchestra.packages import AmbiguousExecutable, ExecutableNotFound, find_executable
+from orchestra.packages.index import reset_index
+
+
+def script(path, body="#!/bin/sh\necho hi\n", mode=0o755):
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(body)
+    os.chmod(path, mode)
+    return path
+
+
+def package(root, name, deps=()):
+    d = root / name
+    d.mkdir(parents=True, exist_ok=True)
+    body = "".join(f"<depend>{dep}</depend>" for dep in deps)
+    (d / "package.xml").write_text(f"<package format='2'><name>{name}</name><version>1.0.0</version>"
+                                   f"<description>x</description>{body}</package>")
+    return d
+
+
+@pytest.fixture
+def env(tmp_path, monkeypatch):
+    """An isolated package path: tmp/src on ROS_PACKAGE_PATH, cache in tmp, cwd outside it."""
+    src = tmp_path / "src"
+    src.mkdir()
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(src))
+    monkeypatch.setenv("ROS_HOME", str(tmp_path / "ros_home"))
+    monkeypatch.delenv("CMAKE_PREFIX_PATH", raising=False)
+    monkeypatch.chdir(tmp_path)
+    reset_index()
+    yield src
+    reset_index()
+
+
+def cli(*args, cwd=None, env_extra=None, timeout=60):
+    env = {**os.environ, **(env_extra or {})}
+    return subprocess.run([sys.executable, "-m", "orchestra", *args], capture_output=True,
+                          text=True, timeout=timeout, cwd=cwd, env=env)
+
+
+def test_executable_found_anywhere_in_package_tree(env):
+    pkg = package(env, "talkers")
+    exe = script(pkg / "scripts" / "deep" / "talker")
+    assert find_executable("talkers", "talker") == str(exe)
+
+
+def test_non_executable_file_is_not_a_match(env):
+    pkg = package(env, "talkers")
+    script(pkg / "scripts" / "talker", mode=0o644)
+    with pytest.raises(ExecutableNotFound, match="chmod \\+x"):
+        find_executable("talkers", "talker")
+
+
+def test_two_executables_of_one_name_is_an_error_naming_both(env):
+    pkg = package(env, "twins")
+    a = script(pkg / "scripts" / "node")
+    b = script(pkg / "bin" / "node")
+    with pytest.raises(AmbiguousExecutable) as info:
+        find_executable("twins", "node")
+    assert sorted(info.value.candidates) == sorted([str(a), str(b)])
+    assert str(a) in str(info.value) and str(b) in str(info.value)
+
+
+def test_hidden_directories_are_not_searched(env):
+    pkg = package(env, "hid")
+    script(pkg / ".git" / "node")
+    with pytest.raises(ExecutableNotFound):
+        find_executable("hid", "node")
+
+
+def test_catkin_devel_lib_dir_wins_over_source_script(env, tmp_path, monkeypatch):
+    pkg = package(env, "built")
+    script(pkg / "scripts" / "node")  # the source a catkin relay script points at
+    devel = tmp_path / "devel"
+    (devel / ".catkin").parent.mkdir(parents=True, exist_ok=True)
+    (devel / ".catkin").write_text("")
+    built = script(devel / "lib" / "built" / "node")
+    monkeypatch.setenv("CMAKE_PREFIX_PATH", str(devel))
+    reset_index()
+    assert find_executable("built", "node") == str(built)
+
+
+def test_unknown_package_is_package_not_found(env):
+    from orchestra.packages import PackageNotFound
+    with pytest.raises(PackageNotFound):
+        find_executable("no_such_pkg", "x")
+
+
+def test_pkg_find_and_list_and_duplicates(env, tmp_path):
+    package(env, "alpha")
+    other = tmp_path / "other"
+    package(other, "alpha")
+    package(other, "beta")
+    extra = {"ROS_PACKAGE_PATH": f"{env}{os.pathsep}{other}"}
+    proc = cli("pkg", "find", "alpha", cwd=tmp_path, env_extra=extra)
+    assert proc.returncode == 0 and proc.stdout.strip() == str(env / "alpha")
+    proc = cli("pkg", "list", cwd=tmp_path, env_extra=extra)
+    assert f"alpha {env / 'alpha'}" in proc.stdout.splitlines()
+    assert f"beta {other / 'beta'}" in proc.stdout.splitlines()
+    proc = cli("pkg", "list", "--duplicates", cwd=tmp_path, env_extra=extra)
+    assert proc.stdout.splitlines() == [f"alpha {env / 'alpha'}", f"alpha {other / 'alpha'} (shadowed)"]
+
+
+def test_pkg_find_unknown_package_is_one_line_error_exit_2(env, tmp_path):
+    proc = cli("pkg", "find", "nowhere_pkg", cwd=tmp_path)
+    assert proc.returncode == 2
+    assert proc.stderr.startswith("orchestra: error: package 'nowhere_pkg' not found")
+    assert "Traceback" not in proc.stderr
+
+
+def test_pkg_deps_is_transitive_and_direct_with_dash_1(env, tmp_path):
+    package(env, "top", ["mid"])
+    package(env, "mid", ["low"])
+    package(env, "low")
+    proc = cli("pkg", "deps", "top", cwd=tmp_path)
+    assert proc.stdout.split() == ["low", "mid"]
+    assert cli("pkg", "deps", "-1", "top", cwd=tmp_path).stdout.split() == ["mid"]
+    assert cli("pkg", "deps", "--on", "low", cwd=tmp_path).stdout.split() == ["mid", "top"]
+
+
+def test_pkg_deps_invalid_manifest_reports_file_and_line(env, tmp_path):
+    bad = env / "broken"
+    bad.mkdir()
+    (bad / "package.xml").write_text("<package format='2'>\n<name>broken</name>\n<version>1.0.0\n</package>\n")
+    proc = cli("pkg", "deps", "broken", cwd=tmp_path)
+    assert proc.returncode == 2
+    assert f"{bad / 'package.xml'}:4" in proc.stderr and "Traceback" not in proc.stderr
+
+
+@pytest.mark.timeout(60)
+def test_run_passes_arguments_and_exit_code_through(env, tmp_path):
+    pkg = package(env, "runner")
+    script(pkg / "scripts" / "exiter", '#!/bin/sh\necho "args:$*"\nexit 7\n')
+    proc = cli("run", "runner", "exiter", "a", "--flag", "b:=c", cwd=tmp_path)
+    assert proc.returncode == 7
+    assert proc.stdout.strip() == "args:a --flag b:=c"
+
+
+@pytest.mark.timeout(60)
+def test_run_with_prefix_runs_under_the_prefix_command(env, tmp_path):
+    pkg = package(env, "runner")
+    script(pkg / "scripts" / "show", "#!/bin/sh\necho shown\n")
+    prefix = """sh -c 'echo "prefix saw $0 $1"; exec "$0" "$@"'"""
+    proc = cli("run", "--prefix", prefix, "runner", "show", "x", cwd=tmp_path)
+    assert proc.returncode == 0
+    assert proc.stdout.splitlines() == [f"prefix saw {pkg / 'scripts' / 'show'} x", "shown"]
+
+
+@pytest.mark.timeout(60)
+def test_run_execs_so_signals_reach_the_node_directly(env, tmp_path):
+    """`run` replaces itself with the node: the pid we started IS the node, SIGTERM ends it."""
+    pkg = package(env, "runner")
+    script(pkg / "scripts" / "sleeper", textwrap.dedent("""\
+        #!/bin/sh
+        trap 'echo got-term; exit 143' TERM
+        echo "pid:$$"
+        while true; do sleep 0.1; done
+        """))
+    proc = subprocess.Popen([sys.executable, "-m", "orchestra", "run", "runner", "sleeper"],
+                            stdout=subprocess.PIPE, text=True, cwd=tmp_path)
+    try:
+        line = proc.stdout.readline().strip()
+        assert line == f"pid:{proc.pid}"
+        proc.send_signal(signal.SIGTERM)
+        out, _ = proc.communicate(timeout=20)
+        assert "got-term" in out and proc.returncode == 143
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+
+
+def test_run_unknown_executable_is_one_line_error(env, tmp_path):
+    package(env, "runner")
+    proc = cli("run", "runner", "nope", cwd=tmp_path)
+    assert proc.returncode == 2
+    assert "cannot find executable 'nope' in package 'runner'" in proc.stderr
+    assert "Traceback" not in proc.stderr
