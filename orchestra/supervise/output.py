@@ -183,6 +183,10 @@ class NodeOutput:
             for stream, suffix in (("out", "stdout"), ("err", "stderr")):
                 path = os.path.join(log_dir, f"{log_name}-{suffix}.log")
                 self.files[stream] = RotatingFile(path, max_bytes, backups)
+                try:
+                    self.files[stream].write(b"")   # exists from the start, like roslaunch's
+                except OSError:
+                    pass
 
     def _to_screen(self, stream: str) -> bool:
         return self.mode != OutputMode.LOG or stream == "err"

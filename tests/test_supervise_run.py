@@ -1,0 +1,196 @@
+"""``run_plan``: a hand-built LaunchPlan run for real (embedded master on a free port)."""
+from __future__ import annotations
+
+import json
+import os
+import socket
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from orchestra.errors import OrchestraError
+from orchestra.launch.plan import LaunchPlan, Machine, Node
+from orchestra.supervise.cli import run_plan
+from orchestra.supervise.command import node_argv
+from orchestra.supervise.output import Screen
+from orchestra.supervise.process import OutputMode, ProcessSpec, State
+from orchestra.supervise.status import StatusServer, ProcessStats, query, snapshot
+from orchestra.supervise.supervisor import Supervisor
+
+pytestmark = pytest.mark.timeout(60)
+
+PROBE = r'''#!/usr/bin/env python3
+"""Records how it was started, reads params from the master, then behaves as asked."""
+import json, os, sys, time, xmlrpc.client
+master = xmlrpc.client.ServerProxy(os.environ["ROS_MASTER_URI"])
+name = [a for a in sys.argv if a.startswith("__name:=")][0][8:]
+record = {"argv": sys.argv, "cwd": os.getcwd(),
+          "env": {k: os.environ.get(k) for k in ("ROS_MASTER_URI", "ROS_NAMESPACE", "NODE_ENV")},
+          "param": master.getParam("/probe", "/p")[2],
+          "run_id": master.getParam("/probe", "/run_id")[2]}
+with open(os.path.join(os.environ["PROBE_OUT"], name + ".json"), "w") as fh:
+    json.dump(record, fh)
+mode = os.environ.get("PROBE_MODE_" + name, "exit0")
+if mode == "sleep":
+    time.sleep(100)
+sys.exit(int(mode[4:]))
+'''
+
+
+def free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+@pytest.fixture
+def run_env(tmp_path, monkeypatch):
+    ws = tmp_path / "ws"
+    nodes = ws / "demo" / "nodes"
+    nodes.mkdir(parents=True)
+    (ws / "demo" / "package.xml").write_text(
+        "<package format='2'><name>demo</name><version>0.0.0</version><description>d"
+        "</description><maintainer email='a@b.c'>a</maintainer><license>BSD</license></package>")
+    probe = nodes / "probe"
+    probe.write_text(PROBE.replace("/usr/bin/env python3", sys.executable))
+    probe.chmod(0o755)
+    out = tmp_path / "out"
+    out.mkdir()
+    port = free_port()
+    for key in ("ROS_LOG_DIR", "ROS_NAMESPACE", "CMAKE_PREFIX_PATH"):
+        monkeypatch.delenv(key, raising=False)
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(ws))
+    monkeypatch.setenv("ROS_HOME", str(tmp_path / "home"))
+    monkeypatch.setenv("ROS_MASTER_URI", f"http://localhost:{port}/")
+    monkeypatch.setenv("XDG_RUNTIME_DIR", str(tmp_path))
+    monkeypatch.setenv("PROBE_OUT", str(out))
+    return {"tmp": tmp_path, "probe": str(probe), "out": out, "port": port}
+
+
+def record(run_env, name):
+    return json.loads((run_env["out"] / f"{name}.json").read_text())
+
+
+OPTS = {"run_id": "testrun", "status_view": False, "disable_title": True}
+
+
+def test_node_runs_with_roslaunch_argv_env_cwd_and_sees_params(run_env):
+    node = Node("demo", "probe", "probe", "/robot/", args="a 'b c'",
+                remap_args=(("in", "/abs"),), env_args=(("NODE_ENV", "n1"),))
+    plan = LaunchPlan(params={"/p": 42}, nodes=(node,))
+    assert run_plan(plan, OPTS) == 0
+    got = record(run_env, "probe")
+    log_dir = run_env["tmp"] / "home" / "log" / "testrun"
+    assert got["argv"][1:] == node_argv(node, run_env["probe"],
+                                        log_file=str(log_dir / "robot-probe-1.log"))[1:]
+    assert got["env"] == {"ROS_MASTER_URI": f"http://localhost:{run_env['port']}/",
+                          "ROS_NAMESPACE": "/robot", "NODE_ENV": "n1"}
+    assert got["cwd"] == str(run_env["tmp"] / "home")
+    assert got["param"] == 42 and got["run_id"] == "testrun"
+    assert (run_env["tmp"] / "home" / "log" / "latest").resolve() == log_dir
+
+
+def test_cwd_node_runs_in_the_executable_directory(run_env):
+    plan = LaunchPlan(nodes=(Node("demo", "probe", "probe", cwd="node",
+                                  launch_prefix="env"),))
+    assert run_plan(plan, OPTS) == 0
+    assert record(run_env, "probe")["cwd"] == os.path.dirname(run_env["probe"])
+
+
+def test_required_node_death_exits_nonzero_naming_the_node(run_env, monkeypatch, capsys):
+    monkeypatch.setenv("PROBE_MODE_vital", "exit5")
+    monkeypatch.setenv("PROBE_MODE_idle", "sleep")
+    plan = LaunchPlan(nodes=(Node("demo", "probe", "idle"),
+                             Node("demo", "probe", "vital", required=True)))
+    assert run_plan(plan, OPTS) == 1
+    assert "required process /vital died (exit code 5)" in capsys.readouterr().err
+
+
+def test_all_required_flag_makes_any_death_fatal(run_env, monkeypatch, capsys):
+    monkeypatch.setenv("PROBE_MODE_idle", "sleep")
+    monkeypatch.setenv("PROBE_MODE_quitter", "exit0")
+    plan = LaunchPlan(nodes=(Node("demo", "probe", "idle"), Node("demo", "probe", "quitter")))
+    assert run_plan(plan, dict(OPTS, all_required=True)) == 1
+    assert "/quitter" in capsys.readouterr().err
+
+
+def test_missing_executable_fails_before_anything_starts(run_env):
+    from orchestra.master import master_is_up
+
+    plan = LaunchPlan(nodes=(Node("demo", "probe", "ok"),
+                             Node("demo", "nope", "bad", filename="/x/demo.launch", line=9)))
+    with pytest.raises(OrchestraError) as info:
+        run_plan(plan, OPTS)
+    assert str(info.value).startswith("/x/demo.launch:9: ")
+    assert not (run_env["out"] / "ok.json").exists()
+    assert not (run_env["tmp"] / "home" / "log").exists()
+    assert not master_is_up(f"http://localhost:{run_env['port']}/", timeout=0.5)
+
+
+def test_remote_machine_needs_local_flag(run_env):
+    plan = LaunchPlan(nodes=(Node("demo", "probe", "far", machine_name="robot",
+                                  filename="r.launch", line=3),),
+                      machines={"robot": Machine("robot", address="192.0.2.7")})
+    with pytest.raises(OrchestraError) as info:
+        run_plan(plan, OPTS)
+    assert "r.launch:3: " in str(info.value) and "--local" in str(info.value)
+    assert run_plan(plan, dict(OPTS, local=True)) == 0
+
+
+def test_bad_node_timeout_option_is_a_user_error(run_env):
+    with pytest.raises(OrchestraError):
+        run_plan(LaunchPlan(), dict(OPTS, node_timeouts=("/x=soon",)))
+
+
+def test_status_socket_reports_every_node(tmp_path):
+    import io
+
+    specs = [ProcessSpec(f"/n{i}", ("sleep", "100"), dict(os.environ), str(tmp_path),
+                         output=OutputMode.SCREEN) for i in range(3)]
+    sup = Supervisor(specs, screen=Screen(io.BytesIO(), io.BytesIO(), colour=False))
+    stats = ProcessStats()
+    path = str(tmp_path / "s.sock")
+    server = StatusServer(sup.loop, lambda: snapshot(sup.procs, stats, {"run_id": "r"}), path)
+    answers = []
+
+    def client() -> None:
+        deadline = time.monotonic() + 10
+        while time.monotonic() < deadline:
+            doc = query(path)
+            if all(n["state"] == "RUNNING" for n in doc["nodes"]):
+                answers.append(doc)
+                cli = subprocess.run([sys.executable, "-m", "orchestra", "status",
+                                      "--socket", path], capture_output=True, text=True)
+                answers.append(cli.stdout)
+                break
+            time.sleep(0.05)
+        sup.loop.call_threadsafe(lambda: sup.request_stop("test done"))
+
+    thread = threading.Thread(target=client)
+    thread.start()
+    try:
+        sup.run(install_signals=False)
+    finally:
+        thread.join()
+        server.close()
+    doc, table = answers
+    assert doc["run_id"] == "r"
+    assert [n["name"] for n in doc["nodes"]] == ["/n0", "/n1", "/n2"]
+    assert all(n["pid"] == p.pid for n, p in zip(doc["nodes"], sup.procs))
+    assert all(isinstance(n["rss"], int) and n["rss"] > 0 for n in doc["nodes"])
+    lines = table.splitlines()
+    assert lines[1].split()[:2] == ["NODE", "STATE"]
+    assert [line.split()[:2] for line in lines[2:]] == [[f"/n{i}", "RUNNING"] for i in range(3)]
+    assert not os.path.exists(path)
+    assert all(p.state == State.EXITED for p in sup.procs)
+
+
+def test_orchestra_status_without_launch_says_so(tmp_path):
+    env = dict(os.environ, XDG_RUNTIME_DIR=str(tmp_path))
+    cli = subprocess.run([sys.executable, "-m", "orchestra", "status"], env=env,
+                         capture_output=True, text=True)
+    assert cli.returncode == 1 and "no running orchestra launch" in cli.stderr
