@@ -47,6 +47,7 @@ class MasterHandle:
         self.params: ParamTree = api.params
         self.shutdown_reason: str | None = None
         self._stopped = threading.Event()
+        self._stopping = False
         self._lock = threading.Lock()
         self._thread = threading.Thread(target=server.serve_forever, kwargs={"poll_interval": 0.1},
                                         name=f"master :{self.port}", daemon=True)
@@ -57,14 +58,18 @@ class MasterHandle:
     def shutdown(self, reason: str = "shutdown requested") -> None:
         """Stop serving, end open connections, free the port. Safe to call twice."""
         with self._lock:
-            if self._stopped.is_set():
+            if self._stopping:
+                self._stopped.wait()
                 return
+            self._stopping = True
             self.shutdown_reason = reason
+        try:
+            self._server.shutdown()  # waits for serve_forever to return (never our thread)
+            self._server.close_connections()
+            self._server.server_close()
+            self.api.notifier.close()
+        finally:
             self._stopped.set()
-        self._server.shutdown()  # waits for serve_forever to return (never our thread)
-        self._server.close_connections()
-        self._server.server_close()
-        self.api.notifier.close()
         log.info("master %s stopped: %s", self.uri, reason)
 
     def _remote_shutdown(self, reason: str) -> None:
@@ -78,7 +83,7 @@ class MasterHandle:
 
     @property
     def running(self) -> bool:
-        return not self._stopped.is_set()
+        return not self._stopping
 
     def __enter__(self) -> "MasterHandle":
         return self

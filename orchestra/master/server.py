@@ -43,7 +43,7 @@ class ThreadedXMLRPCServer(socketserver.ThreadingMixIn, SimpleXMLRPCServer):
         super().__init__(addr, requestHandler=_Handler, logRequests=False, allow_none=False,
                          bind_and_activate=True)
         self._connections: set[socket.socket] = set()
-        self._conn_lock = threading.Lock()
+        self._conn_lock = threading.Condition()
 
     def process_request(self, request, client_address):
         with self._conn_lock:
@@ -51,19 +51,28 @@ class ThreadedXMLRPCServer(socketserver.ThreadingMixIn, SimpleXMLRPCServer):
         super().process_request(request, client_address)
 
     def shutdown_request(self, request):
+        super().shutdown_request(request)
         with self._conn_lock:
             self._connections.discard(request)
-        super().shutdown_request(request)
+            self._conn_lock.notify_all()
 
-    def close_connections(self) -> None:
-        """End every open client connection (their handler threads then exit)."""
+    def close_connections(self, grace: float = 2.0) -> None:
+        """End every open client connection (their handler threads then exit).
+
+        Only the read side is shut: a handler blocked waiting for the next keep-alive
+        request sees end-of-file at once, while one still answering (e.g. the ``shutdown``
+        call that triggered this) can finish writing its reply; we wait up to ``grace``
+        seconds for those.
+        """
         with self._conn_lock:
             connections = list(self._connections)
         for conn in connections:
             try:
-                conn.shutdown(socket.SHUT_RDWR)
+                conn.shutdown(socket.SHUT_RD)
             except OSError:
                 pass
+        with self._conn_lock:
+            self._conn_lock.wait_for(lambda: not self._connections, grace)
 
 
 def bind_address(host: str | None = None, environ: dict[str, str] | None = None

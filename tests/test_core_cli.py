@@ -1,0 +1,86 @@
+"""``orchestra core`` runs a standalone master like roscore."""
+from __future__ import annotations
+
+import os
+import signal
+import socket
+import subprocess
+import sys
+import xmlrpc.client
+
+import pytest
+
+from orchestra.master import master_is_up
+
+pytestmark = pytest.mark.timeout(60)
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.fixture
+def core():
+    """Start ``orchestra core`` with the given args; yields (process, master URI)."""
+    procs: list[subprocess.Popen] = []
+
+    def start(*args: str, env: dict[str, str] | None = None) -> tuple[subprocess.Popen, str]:
+        full_env = {**os.environ, **(env or {})}
+        full_env.pop("ROS_IP", None)
+        full_env.pop("ROS_HOSTNAME", None)
+        proc = subprocess.Popen([sys.executable, "-m", "orchestra", "core", *args],
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                env=full_env)
+        procs.append(proc)
+        line = proc.stdout.readline()
+        assert line.startswith("ROS_MASTER_URI="), line + proc.stderr.read()
+        return proc, line.strip().split("=", 1)[1]
+    yield start
+    for proc in procs:
+        if proc.poll() is None:
+            proc.kill()
+        proc.wait(10)
+        proc.stdout.close()
+        proc.stderr.close()
+
+
+def test_core_serves_and_sets_roscore_params(core):
+    proc, uri = core("-p", "0")
+    m = xmlrpc.client.ServerProxy(uri)
+    assert m.getPid("/t") == [1, "", proc.pid]
+    assert m.getUri("/t")[2] == uri
+    params = m.getParam("/t", "/")[2]
+    assert params["rosdistro"].endswith("\n") and params["rosversion"].endswith("\n")
+    assert len(params["run_id"]) == 36  # a uuid, as roslaunch writes it
+
+
+def test_core_stops_cleanly_on_sigint(core):
+    proc, uri = core("-p", "0")
+    proc.send_signal(signal.SIGINT)
+    assert proc.wait(10) == 0
+    assert not master_is_up(uri, timeout=0.5)
+
+
+def test_core_stops_on_xmlrpc_shutdown(core):
+    proc, uri = core("-p", "0")
+    assert xmlrpc.client.ServerProxy(uri).shutdown("/t", "test")[0] == 1
+    assert proc.wait(10) == 0
+
+
+def test_core_takes_port_from_ros_master_uri(core):
+    port = _free_port()
+    proc, uri = core(env={"ROS_MASTER_URI": f"http://localhost:{port}/"})
+    assert uri == f"http://127.0.0.1:{port}/"
+    assert master_is_up(uri)
+
+
+def test_second_core_on_same_port_refuses_with_clear_message(core):
+    proc, uri = core("-p", "0")
+    port = uri.rsplit(":", 1)[1].strip("/")
+    second = subprocess.run([sys.executable, "-m", "orchestra", "core", "-p", port],
+                            capture_output=True, text=True, timeout=30)
+    assert second.returncode == 1
+    assert "already running" in second.stderr and "Traceback" not in second.stderr
+    assert master_is_up(uri)  # the first one is untouched
