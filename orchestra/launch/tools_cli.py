@@ -42,3 +42,42 @@ def convert(path: str, fmt: str, output: str | None) -> None:
             raise OrchestraError(f"cannot write {output}: {exc.strerror}") from None
     else:
         sys.stdout.write(text)
+
+
+def _split_words(words: tuple[str, ...]) -> tuple[list[str], dict[str, str]]:
+    """Files and ``name:=value`` args, in any order (roslaunch's command-line convention)."""
+    files: list[str] = []
+    args: dict[str, str] = {}
+    for word in words:
+        if ":=" in word:
+            name, _, value = word.partition(":=")
+            args[name] = value
+        else:
+            files.append(word)
+    return files, args
+
+
+@click.command()
+@click.argument("words", nargs=-1, required=True, metavar="FILE... [name:=value ...]")
+@click.option("--strict", is_flag=True, help="Warnings fail the check too.")
+@click.pass_context
+def check(ctx: click.Context, words: tuple[str, ...], strict: bool) -> None:
+    """Report every problem in launch files (and what they include), starting nothing.
+
+    Each line is FILE:LINE:COLUMN: error|warning: message [code]. Exit status: 0 when no
+    errors were found (warnings allowed unless --strict), 1 otherwise.
+    """
+    from orchestra.launch.check import check_files
+
+    files, args = _split_words(words)
+    if not files:
+        raise click.UsageError("give at least one launch file")
+    report = check_files(files, args)
+    for problem in report.sorted():
+        click.echo(str(problem))
+    errors, warnings = len(report.errors), len(report.warnings)
+    summary = (f"{len(report.files)} file(s) checked: {errors} error(s), "
+               f"{warnings} warning(s)")
+    click.echo(summary, err=True)
+    if errors or (strict and warnings):
+        ctx.exit(1)

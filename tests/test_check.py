@@ -1,0 +1,268 @@
+"""``orchestra check``: every problem, located to the column, nothing run."""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from conftest import COMPAT
+from orchestra.launch.check import ERROR, WARNING, check_files
+
+
+@pytest.fixture
+def ws(tmp_path, monkeypatch):
+    """A workspace with one package, ``mypkg``, on ROS_PACKAGE_PATH."""
+    pkg = tmp_path / "ws" / "mypkg"
+    (pkg / "launch").mkdir(parents=True)
+    (pkg / "config").mkdir()
+    (pkg / "package.xml").write_text("<package><name>mypkg</name></package>\n")
+    (pkg / "config" / "gains.yaml").write_text("p: 1.0\n")
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(tmp_path / "ws"))
+    return pkg
+
+
+def write(directory: Path, name: str, text: str) -> str:
+    path = directory / name
+    path.write_text(text)
+    return str(path)
+
+
+def codes(report, severity=None):
+    return sorted(p.code for p in report.problems
+                  if severity is None or p.severity == severity)
+
+
+def only(report, code):
+    found = [p for p in report.problems if p.code == code]
+    assert len(found) == 1, [str(p) for p in report.problems]
+    return found[0]
+
+
+def test_clean_file_has_no_problems(ws):
+    path = write(ws / "launch", "ok.launch",
+                 '<launch>\n  <arg name="rate" default="10"/>\n'
+                 '  <node pkg="mypkg" type="t" name="n" args="$(arg rate)">\n'
+                 '    <rosparam file="$(find mypkg)/config/gains.yaml" command="load"/>\n'
+                 '  </node>\n</launch>\n')
+    assert check_files([path]).problems == []
+
+
+def test_unknown_tag_is_an_error_with_line_and_column(ws):
+    path = write(ws / "launch", "a.launch", '<launch>\n  <nod pkg="mypkg" type="t" name="n"/>\n'
+                 '</launch>\n')
+    problem = only(check_files([path]), "unknown-tag")
+    assert problem.severity == ERROR
+    assert (problem.location.file, problem.location.line, problem.location.column) == \
+        (path, 2, 3)
+    assert "did you mean 'node'" in problem.message
+
+
+def test_tag_in_the_wrong_parent_is_reported(ws):
+    path = write(ws / "launch", "a.launch", '<launch>\n  <include file="$(dirname)/b.launch">'
+                 '\n    <param name="p" value="1"/>\n  </include>\n</launch>\n')
+    write(ws / "launch", "b.launch", "<launch/>\n")
+    problem = only(check_files([path]), "unknown-tag")
+    assert "<param> is not allowed inside <include>" in problem.message
+    assert problem.location.line == 3
+
+
+def test_unknown_attribute_is_a_warning_pointing_at_the_attribute(ws):
+    path = write(ws / "launch", "a.launch",
+                 '<launch>\n  <node pkg="mypkg" type="t" name="n"\n        respwan="true"/>\n'
+                 '</launch>\n')
+    problem = only(check_files([path]), "unknown-attribute")
+    assert problem.severity == WARNING
+    assert (problem.location.line, problem.location.column) == (3, 9)
+    assert "did you mean 'respawn'" in problem.message
+
+
+def test_undeclared_arg_is_an_error_unless_given_on_the_command_line(ws):
+    path = write(ws / "launch", "a.launch",
+                 '<launch>\n  <param name="p" value="$(arg speed)"/>\n</launch>\n')
+    problem = only(check_files([path]), "undeclared-arg")
+    assert problem.severity == ERROR and "'speed'" in problem.message
+    assert (problem.location.line, problem.location.column) == (2, 19)
+    assert "undeclared-arg" not in codes(check_files([path], {"speed": "2"}))
+
+
+def test_args_read_by_eval_count_as_used_and_declared(ws):
+    path = write(ws / "launch", "a.launch",
+                 '<launch>\n  <arg name="a" default="1"/>\n  <arg name="b" default="2"/>\n'
+                 '  <param name="p" value="$(eval a + arg(\'b\') + c)"/>\n</launch>\n')
+    report = check_files([path])
+    assert "unused-arg" not in codes(report)
+    assert "'c'" in only(report, "undeclared-arg").message
+
+
+def test_unused_arg_is_a_warning(ws):
+    path = write(ws / "launch", "a.launch",
+                 '<launch>\n  <arg name="used" default="1"/>\n  <arg name="idle" default="2"/>\n'
+                 '  <param name="p" value="$(arg used)"/>\n</launch>\n')
+    problem = only(check_files([path]), "unused-arg")
+    assert problem.severity == WARNING and "'idle'" in problem.message
+    assert problem.location.line == 3
+
+
+def test_pass_all_args_makes_every_arg_used(ws):
+    write(ws / "launch", "inner.launch", '<launch>\n  <arg name="x"/>\n'
+          '  <param name="p" value="$(arg x)"/>\n</launch>\n')
+    path = write(ws / "launch", "a.launch", '<launch>\n  <arg name="x" default="1"/>\n'
+                 '  <include file="$(dirname)/inner.launch" pass_all_args="true"/>\n</launch>\n')
+    assert check_files([path]).problems == []
+
+
+def test_missing_package_is_an_error_in_a_taken_branch_and_a_warning_otherwise(ws):
+    path = write(ws / "launch", "a.launch",
+                 '<launch>\n  <arg name="sim" default="false"/>\n'
+                 '  <node pkg="nopkg" type="t" name="a"/>\n'
+                 '  <include if="$(arg sim)" file="$(find gazebo_nowhere)/x.launch"/>\n'
+                 '</launch>\n')
+    report = check_files([path])
+    by_line = {p.location.line: p for p in report.problems if p.code == "missing-package"}
+    assert by_line[3].severity == ERROR and "'nopkg'" in by_line[3].message
+    assert by_line[4].severity == WARNING and "not take" in by_line[4].message
+    assert report.errors  # the node's package really is missing
+    with_sim = check_files([path], {"sim": "true"})
+    assert [p.severity for p in with_sim.problems
+            if p.code == "missing-package" and p.location.line == 4] == [ERROR]
+
+
+def test_missing_rosparam_and_textfile_files_are_reported(ws):
+    path = write(ws / "launch", "a.launch",
+                 '<launch>\n  <rosparam command="load" file="$(find mypkg)/config/none.yaml"/>\n'
+                 '  <param name="t" textfile="$(dirname)/missing.txt"/>\n'
+                 '  <rosparam command="dump" file="$(dirname)/written_later.yaml"/>\n'
+                 '</launch>\n')
+    report = check_files([path])
+    missing = sorted((p.location.line, p.location.column) for p in report.problems
+                     if p.code == "missing-file")
+    assert missing == [(2, 28), (3, 19)]
+
+
+def test_include_cycle_is_reported_once_with_the_chain(ws):
+    a = write(ws / "launch", "a.launch",
+              '<launch>\n  <include file="$(dirname)/b.launch"/>\n</launch>\n')
+    write(ws / "launch", "b.launch",
+          '<launch>\n  <include file="$(find mypkg)/launch/a.launch"/>\n</launch>\n')
+    report = check_files([a])
+    cycle = only(report, "include-cycle")
+    assert cycle.severity == ERROR
+    assert "a.launch -> b.launch -> a.launch" in cycle.message
+
+
+def test_duplicate_node_names_are_reported_from_the_resolved_plan(ws):
+    path = write(ws / "launch", "a.launch",
+                 '<launch>\n  <group ns="g">\n    <node pkg="mypkg" type="t" name="n"/>\n'
+                 '  </group>\n  <node pkg="mypkg" type="t" name="n" ns="g"/>\n</launch>\n')
+    report = check_files([path])
+    [problem] = report.errors
+    assert "duplicate node name [/g/n]" in problem.message
+    assert problem.location.line == 5
+
+
+def test_respawn_with_required_is_an_error(ws):
+    path = write(ws / "launch", "a.launch",
+                 '<launch>\n  <node pkg="mypkg" type="t" name="n" respawn="true" '
+                 'required="true"/>\n</launch>\n')
+    problem = only(check_files([path]), "respawn-required")
+    assert problem.severity == ERROR
+    assert problem.location.column == 54
+
+
+def test_every_problem_is_reported_not_only_the_first(ws):
+    path = write(ws / "launch", "a.launch",
+                 '<launch>\n'
+                 '  <param name="a" value="$(arg nope)"/>\n'            # undeclared arg
+                 '  <node pkg="mypkg" type="t" name="n" output="loud"/>\n'  # bad value
+                 '  <rosparam file="$(dirname)/none.yaml"/>\n'           # missing file
+                 '  <param name="b"/>\n'                                 # no value
+                 '</launch>\n')
+    report = check_files([path])
+    assert sorted(p.location.line for p in report.errors) == [2, 3, 4, 5]
+
+
+def test_problems_inside_included_files_carry_their_own_file(ws):
+    write(ws / "launch", "inner.launch",
+          '<launch>\n  <node pkg="mypkg" type="t" name="n" output="loud"/>\n</launch>\n')
+    path = write(ws / "launch", "a.launch",
+                 '<launch>\n  <include file="$(dirname)/inner.launch"/>\n</launch>\n')
+    [problem] = check_files([path]).errors
+    assert problem.location.file.endswith("inner.launch")
+    assert problem.location.line == 2 and "output" in problem.message
+
+
+def test_yaml_launch_files_are_checked_with_yaml_columns(ws):
+    path = write(ws / "launch", "a.launch.yaml",
+                 "launch:\n  - node: {pkg: mypkg, type: t, name: n, respwan: 'true'}\n")
+    problem = only(check_files([path]), "unknown-attribute")
+    assert (problem.location.line, problem.location.column) == (2, 42)
+
+
+def test_syntax_error_is_one_located_problem(ws):
+    path = write(ws / "launch", "a.launch", "<launch>\n  <node\n</launch>\n")
+    [problem] = check_files([path]).problems
+    assert problem.code == "syntax" and problem.location.file == path
+
+
+def test_command_params_are_not_run(ws, tmp_path):
+    marker = tmp_path / "ran"
+    path = write(ws / "launch", "a.launch",
+                 f'<launch>\n  <param name="p" command="touch {marker}"/>\n</launch>\n')
+    assert check_files([path]).problems == []
+    assert not marker.exists()
+
+
+# ---------------------------------------------------------------------------------- CLI
+
+def run_cli(*args, env=None):
+    return subprocess.run([sys.executable, "-m", "orchestra", "check", *args],
+                          capture_output=True, text=True, timeout=60, env=env)
+
+
+def test_cli_exit_status_and_line_format(ws):
+    bad = write(ws / "launch", "bad.launch",
+                '<launch>\n  <param name="p" value="$(arg nope)"/>\n</launch>\n')
+    warn = write(ws / "launch", "warn.launch",
+                 '<launch>\n  <arg name="idle" default="1"/>\n</launch>\n')
+    env = dict(os.environ)
+    proc = run_cli(bad, env=env)
+    assert proc.returncode == 1
+    assert proc.stdout.startswith(f"{bad}:2:19: error: arg 'nope'")
+    assert "Traceback" not in proc.stderr
+    assert run_cli(warn, env=env).returncode == 0
+    assert run_cli(warn, "--strict", env=env).returncode == 1
+    assert run_cli(bad, "nope:=1", env=env).returncode == 0
+
+
+def test_cli_missing_file_is_reported_not_a_traceback(tmp_path):
+    proc = run_cli(str(tmp_path / "none.launch"))
+    assert proc.returncode == 1
+    assert "launch file not found" in proc.stdout
+    assert "Traceback" not in proc.stderr
+
+
+# ------------------------------------------------------------------------- the corpus
+
+@pytest.mark.timeout(120)
+def test_check_flags_every_smoke_file_roslaunch_rejects(compat_dir, monkeypatch):
+    """Each of the smoke files roslaunch refuses gets at least one error from check; the
+    files it loads get none except missing packages (the corpus ships no node packages)."""
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(compat_dir / "ws"))
+    monkeypatch.setenv("ROS_DISTRO", "noetic")
+    for var in ("ROS_NAMESPACE", "HOME", "DISPLAY"):
+        monkeypatch.delenv(var, raising=False)
+    smoke = json.loads((compat_dir / "smoke.json").read_text())
+    missed, false_alarms = [], []
+    for item in smoke:
+        report = check_files([str(compat_dir / "ws" / item["launch_file"])])
+        errors = [p for p in report.errors if p.code != "missing-package"]
+        if not item["ok"] and not report.errors:
+            missed.append(item["launch_file"])
+        if item["ok"] and any(p.code not in ("unknown-tag",) for p in errors):
+            false_alarms.append((item["launch_file"], [str(p) for p in errors]))
+    assert missed == []
+    assert false_alarms == []
