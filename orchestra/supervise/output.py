@@ -60,6 +60,9 @@ class RotatingFile:
             self._size = self._fh.tell()
         return self._fh
 
+    def touch(self) -> None:
+        self._open()
+
     def _rotate(self) -> None:
         self.close()
         for i in range(self.backups - 1, 0, -1):
@@ -184,7 +187,7 @@ class NodeOutput:
                 path = os.path.join(log_dir, f"{log_name}-{suffix}.log")
                 self.files[stream] = RotatingFile(path, max_bytes, backups)
                 try:
-                    self.files[stream].write(b"")   # exists from the start, like roslaunch's
+                    self.files[stream].touch()   # exists from the start, like roslaunch's
                 except OSError:
                     pass
 

@@ -1,0 +1,157 @@
+"""``orchestra launch FILE`` as a user runs it: signals to orchestra, SIGKILL, exit codes."""
+from __future__ import annotations
+
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import psutil
+import pytest
+
+pytestmark = pytest.mark.timeout(90)
+
+NODE = """#!/bin/sh
+# a node that forks a helper (same process group), records both pids, and waits
+sleep 1000 &
+echo "$$ $!" > "$PIDS_DIR/$1"
+trap 'kill $! 2>/dev/null; exit 0' INT TERM
+wait
+"""
+
+LAUNCH = """<launch>
+  <node pkg="demo" type="forker" name="a" args="a"/>
+  <group ns="g">
+    <node pkg="demo" type="forker" name="b" args="b" output="screen"/>
+  </group>
+  <node pkg="demo" type="forker" name="c" args="c" respawn="true"/>
+</launch>
+"""
+
+
+def free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+@pytest.fixture
+def launch_env(tmp_path):
+    pkg = tmp_path / "ws" / "demo"
+    (pkg / "nodes").mkdir(parents=True)
+    (pkg / "launch").mkdir()
+    (pkg / "package.xml").write_text(
+        "<package format='2'><name>demo</name><version>0.0.0</version><description>d"
+        "</description><maintainer email='a@b.c'>a</maintainer><license>BSD</license></package>")
+    node = pkg / "nodes" / "forker"
+    node.write_text(NODE)
+    node.chmod(0o755)
+    (pkg / "launch" / "demo.launch").write_text(LAUNCH)
+    pids = tmp_path / "pids"
+    pids.mkdir()
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("ROS_LOG_DIR", "ROS_NAMESPACE", "CMAKE_PREFIX_PATH")}
+    env.update(ROS_PACKAGE_PATH=str(tmp_path / "ws"), ROS_HOME=str(tmp_path / "home"),
+               ROS_MASTER_URI=f"http://localhost:{free_port()}/", PIDS_DIR=str(pids),
+               XDG_RUNTIME_DIR=str(tmp_path))
+    return {"env": env, "launch": str(pkg / "launch" / "demo.launch"), "pids": pids,
+            "tmp": tmp_path}
+
+
+def start(launch_env, *extra):
+    return subprocess.Popen(
+        [sys.executable, "-m", "orchestra", "launch", launch_env["launch"], "--no-status",
+         *extra], env=launch_env["env"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+        text=True)
+
+
+def wait_pids(launch_env, proc, names=("a", "b", "c")) -> list[int]:
+    deadline = time.monotonic() + 30
+    files = [launch_env["pids"] / n for n in names]
+    while not all(f.exists() and len(f.read_text().split()) == 2 for f in files):
+        if proc.poll() is not None or time.monotonic() > deadline:
+            out, err = proc.communicate(timeout=10) if proc.poll() is None else proc.communicate()
+            pytest.fail(f"nodes did not start (exit {proc.returncode}): {err[-2000:]}")
+        time.sleep(0.05)
+    return [int(p) for f in files for p in f.read_text().split()]
+
+
+def alive(pid: int) -> bool:
+    try:
+        return psutil.Process(pid).status() != psutil.STATUS_ZOMBIE
+    except psutil.NoSuchProcess:
+        return False
+
+
+def survivors(pids, limit=5.0) -> list[int]:
+    deadline = time.monotonic() + limit
+    while time.monotonic() < deadline and any(alive(p) for p in pids):
+        time.sleep(0.05)
+    return [p for p in pids if alive(p)]
+
+
+def test_sigkilled_orchestra_launch_leaves_no_node_or_grandchild(launch_env):
+    proc = start(launch_env)
+    try:
+        pids = wait_pids(launch_env, proc)
+        proc.kill()
+        proc.wait(timeout=10)
+        assert survivors(pids) == []
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        proc.communicate()
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP, signal.SIGINT])
+def test_stop_signal_to_orchestra_is_a_graceful_stop(launch_env, sig):
+    proc = start(launch_env)
+    try:
+        pids = wait_pids(launch_env, proc)
+        proc.send_signal(sig)
+        out, err = proc.communicate(timeout=30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert proc.returncode == 0, err
+    assert survivors(pids, limit=1) == []
+    assert f"{signal.Signals(sig).name} received" in err
+    # output="screen" node lines are on orchestra's stdout, prefixed
+    assert "process[/g/b]: started with pid" in out
+
+
+def test_required_node_death_via_cli_exit_code(launch_env):
+    Path(launch_env["launch"]).write_text(
+        LAUNCH.replace('name="a" args="a"', 'name="a" args="a" required="true"'))
+    proc = start(launch_env)
+    try:
+        pids = wait_pids(launch_env, proc)
+        os.kill(pids[0], signal.SIGKILL)     # node /a (required) dies
+        out, err = proc.communicate(timeout=30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert proc.returncode == 1
+    assert "required process /a died (killed by SIGKILL)" in err
+    assert survivors(pids, limit=2) == []
+
+
+def test_log_files_named_like_roslaunch_with_latest_link(launch_env):
+    proc = start(launch_env)
+    try:
+        wait_pids(launch_env, proc)
+        proc.send_signal(signal.SIGINT)
+        proc.communicate(timeout=30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    latest = launch_env["tmp"] / "home" / "log" / "latest"
+    names = sorted(p.name for p in latest.iterdir())
+    # output="log" nodes get files; the output="screen" node /g/b does not
+    assert names == ["a-1-stderr.log", "a-1-stdout.log", "c-3-stderr.log", "c-3-stdout.log"]
