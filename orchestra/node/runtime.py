@@ -239,14 +239,16 @@ class NodeRuntime:
             if self._cleanup is not None:
                 return
             self._shutdown_reason = reason
-            self._shutdown_requested.set()
             log.info("shutdown: %s", reason)
-            self._cleanup = threading.Thread(target=self._do_cleanup, name="node-shutdown",
-                                             daemon=False)
-            self._cleanup.start()
+            thread = threading.Thread(target=self._do_cleanup, name="node-shutdown",
+                                      daemon=False)
+            self._shutdown_requested.set()
+            thread.start()
+            self._cleanup = thread
 
     def wait_shutdown_done(self, timeout: float | None = 10.0) -> None:
-        thread = self._cleanup
+        with self._cleanup_lock:
+            thread = self._cleanup
         if thread is not None and thread is not threading.current_thread():
             thread.join(timeout)
 

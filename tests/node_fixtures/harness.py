@@ -1,0 +1,141 @@
+"""Test harness for node processes: a master per test, processes that report JSON lines.
+
+Imported by tests/test_node_*.py (which put this directory on sys.path). Every process
+started here is killed by the fixture's finalizer; every server uses an ephemeral port.
+"""
+from __future__ import annotations
+
+import json
+import os
+import queue
+import signal
+import subprocess
+import sys
+import threading
+import time
+import xmlrpc.client
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+
+ADD_TWO_INTS = "int64 a\nint64 b\n---\nint64 sum\n"
+NUM_MSG = "# a custom message\nint64 num\nstring label\ntime stamp\nfloat32[3] xyz\n"
+
+
+def make_test_package(root: Path) -> Path:
+    """A catkin package ``test_msgs`` with one .msg and one .srv, under ``root``."""
+    pkg = root / "test_msgs"
+    (pkg / "msg").mkdir(parents=True, exist_ok=True)
+    (pkg / "srv").mkdir(parents=True, exist_ok=True)
+    (pkg / "package.xml").write_text(
+        '<package format="2"><name>test_msgs</name><version>0.0.1</version>'
+        '<description>t</description><maintainer email="a@b.c">a</maintainer>'
+        '<license>BSD</license></package>\n')
+    (pkg / "msg" / "Num.msg").write_text(NUM_MSG)
+    (pkg / "srv" / "AddTwoInts.srv").write_text(ADD_TWO_INTS)
+    return root
+
+
+class NodeProcess:
+    """A child process whose stdout JSON lines are collected by a reader thread."""
+
+    def __init__(self, argv: list[str], env: dict[str, str]):
+        self.argv = argv
+        self.proc = subprocess.Popen(argv, env=env, stdout=subprocess.PIPE,
+                                     stderr=subprocess.PIPE, text=True)
+        self.lines: queue.Queue = queue.Queue()
+        self.seen: list = []
+        self.stderr_lines: list[str] = []
+        threading.Thread(target=self._read, daemon=True).start()
+        threading.Thread(target=self._read_err, daemon=True).start()
+
+    def _read(self) -> None:
+        for line in self.proc.stdout:
+            line = line.strip()
+            if not line:
+                continue
+            try:
+                self.lines.put(json.loads(line))
+            except ValueError:
+                self.lines.put({"text": line})
+
+    def _read_err(self) -> None:
+        for line in self.proc.stderr:
+            self.stderr_lines.append(line.rstrip("\n"))
+
+    def expect(self, predicate, timeout: float = 10.0):
+        """The first (new) JSON line for which ``predicate`` holds; AssertionError on timeout."""
+        deadline = time.monotonic() + timeout
+        while True:
+            remaining = deadline - time.monotonic()
+            if remaining <= 0:
+                raise AssertionError(f"{self.argv[1:3]}: nothing matched within {timeout}s; "
+                                     f"seen {self.seen[-5:]}; stderr {self.stderr_lines[-10:]}")
+            try:
+                item = self.lines.get(timeout=min(remaining, 0.2))
+            except queue.Empty:
+                continue
+            self.seen.append(item)
+            if predicate(item):
+                return item
+
+    def messages(self, timeout: float = 10.0):
+        return self.expect(lambda d: "msg" in d, timeout)["msg"]
+
+    def ready(self, timeout: float = 15.0) -> dict:
+        return self.expect(lambda d: "ready" in d, timeout)
+
+    def signal(self, sig: int) -> None:
+        if self.proc.poll() is None:
+            self.proc.send_signal(sig)
+
+    def wait(self, timeout: float = 10.0) -> int:
+        return self.proc.wait(timeout)
+
+    def kill(self) -> None:
+        if self.proc.poll() is None:
+            self.proc.kill()
+        try:
+            self.proc.wait(5)
+        except subprocess.TimeoutExpired:
+            pass
+
+
+class Nodes:
+    """Starts fixture node scripts against one master; ``close()`` kills what is left."""
+
+    def __init__(self, master_uri: str, package_path: Path):
+        self.master_uri = master_uri
+        self.env = dict(os.environ, ROS_MASTER_URI=master_uri,
+                        ROS_PACKAGE_PATH=str(package_path), PYTHONUNBUFFERED="1")
+        self.env.pop("ROS_NAMESPACE", None)
+        self.procs: list[NodeProcess] = []
+
+    def start(self, script: str, *args: str, env: dict[str, str] | None = None) -> NodeProcess:
+        argv = [sys.executable, str(HERE / script), *args]
+        proc = NodeProcess(argv, dict(self.env, **(env or {})))
+        self.procs.append(proc)
+        return proc
+
+    def master(self) -> xmlrpc.client.ServerProxy:
+        return xmlrpc.client.ServerProxy(self.master_uri)
+
+    def close(self) -> None:
+        for proc in self.procs:
+            if proc.proc.poll() is None:
+                proc.signal(signal.SIGTERM)
+        for proc in self.procs:
+            try:
+                proc.proc.wait(3)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+
+
+def wait_for(predicate, timeout: float = 10.0, interval: float = 0.05):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        value = predicate()
+        if value:
+            return value
+        time.sleep(interval)
+    raise AssertionError(f"condition not met within {timeout}s")

@@ -1,0 +1,286 @@
+"""Node runtime end to end: real node processes talking TCPROS on loopback via a master."""
+from __future__ import annotations
+
+import signal
+import socket
+import sys
+import time
+import xmlrpc.client
+from pathlib import Path
+
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
+from harness import Nodes, make_test_package, wait_for  # noqa: E402
+
+from orchestra.master import start_master  # noqa: E402
+from orchestra.node import tcpros  # noqa: E402
+
+pytestmark = pytest.mark.timeout(60)
+
+
+@pytest.fixture(scope="module")
+def package_path(tmp_path_factory) -> Path:
+    return make_test_package(tmp_path_factory.mktemp("pkgs"))
+
+
+@pytest.fixture
+def master():
+    handle = start_master(host="127.0.0.1", port=0)
+    yield handle
+    handle.shutdown()
+
+
+@pytest.fixture
+def nodes(master, package_path):
+    group = Nodes(master.uri, package_path)
+    yield group
+    group.close()
+
+
+def system_state(master_uri: str):
+    return xmlrpc.client.ServerProxy(master_uri).getSystemState("/test")[2]
+
+
+def publishers_of(master_uri: str, topic: str) -> list[str]:
+    for name, nodes in system_state(master_uri)[0]:
+        if name == topic:
+            return nodes
+    return []
+
+
+def test_subscriber_receives_string_messages_from_publisher(nodes):
+    pub = nodes.start("pub.py", "chatter", "std_msgs/String", "data: hello $N")
+    pub.ready()
+    sub = nodes.start("sub.py", "chatter", "std_msgs/String")
+    assert sub.ready()["topic"] == "/chatter"
+    msg = sub.messages()
+    assert msg["data"].startswith("hello ")
+    assert msg != sub.messages()  # a stream, not one repeated message
+
+
+def test_publisher_started_after_subscriber_is_found_via_publisher_update(nodes):
+    sub = nodes.start("sub.py", "late", "geometry_msgs/Twist")
+    sub.ready()
+    time.sleep(0.3)
+    pub = nodes.start("pub.py", "late", "geometry_msgs/Twist", "{linear: {x: 1.5}, angular: {z: -2}}")
+    pub.ready()
+    msg = sub.messages()
+    assert msg == {"linear": {"x": 1.5, "y": 0.0, "z": 0.0},
+                   "angular": {"x": 0.0, "y": 0.0, "z": -2.0}}
+
+
+def test_latched_message_is_delivered_to_a_subscriber_that_comes_later(nodes):
+    pub = nodes.start("pub.py", "map_version", "std_msgs/Int32", "data: 42",
+                      "--latch", "--count", "1")
+    pub.expect(lambda d: d.get("sent") == 1)
+    sub = nodes.start("sub.py", "map_version", "std_msgs/Int32")
+    got = sub.expect(lambda d: "msg" in d)
+    assert got == {"msg": {"data": 42}, "latching": "1"}
+
+
+def test_custom_message_from_package_msg_file_round_trips(nodes):
+    pub = nodes.start("pub.py", "nums", "test_msgs/Num",
+                      "{num: $N, label: n$N, stamp: {secs: 7, nsecs: 9}, xyz: [1, 2, 3]}")
+    pub.ready()
+    sub = nodes.start("sub.py", "nums", "test_msgs/Num")
+    msg = sub.messages()
+    assert msg["label"] == f"n{msg['num']}"
+    assert msg["stamp"] == {"secs": 7, "nsecs": 9}
+    assert msg["xyz"] == [1.0, 2.0, 3.0]
+
+
+def test_any_type_subscriber_learns_type_from_connection_header(nodes):
+    nodes.start("pub.py", "anything", "std_msgs/String", "data: abc").ready()
+    sub = nodes.start("sub.py", "anything", "*")
+    assert sub.messages() == {"type": "std_msgs/String", "size": 7}
+
+
+def test_subscriber_with_wrong_type_is_refused_and_publisher_keeps_running(nodes):
+    pub = nodes.start("pub.py", "typed", "std_msgs/String", "data: x")
+    pub.ready()
+    wrong = nodes.start("sub.py", "typed", "std_msgs/Int32", "--name", "wrong")
+    wrong.ready()
+    right = nodes.start("sub.py", "typed", "std_msgs/String", "--name", "right")
+    right.ready()
+    assert right.messages() == {"data": "x"}
+    wait_for(lambda: any("typed" in line for line in pub.stderr_lines))
+    assert any("md5" in line or "expects" in line for line in pub.stderr_lines)
+    assert pub.proc.poll() is None and wrong.proc.poll() is None
+    assert wrong.lines.empty()
+
+
+def test_wrong_md5_on_connect_gets_an_error_header(nodes):
+    pub = nodes.start("pub.py", "typed2", "std_msgs/String", "data: x")
+    pub.ready()
+    node_uri = wait_for(lambda: xmlrpc.client.ServerProxy(nodes.master_uri)
+                        .lookupNode("/test", "/pub")[2])
+    code, _, proto = xmlrpc.client.ServerProxy(node_uri).requestTopic(
+        "/test", "/typed2", [["TCPROS"]])
+    assert code == 1 and proto[0] == "TCPROS"
+    with tcpros.connect(proto[1], proto[2]) as sock:
+        tcpros.write_header(sock, {"callerid": "/test", "topic": "/typed2",
+                                   "md5sum": "0" * 32, "type": "std_msgs/Int32"})
+        header = tcpros.read_header(sock)
+    assert "error" in header and "md5" in header["error"]
+    # the publisher still serves a well-formed subscriber
+    with tcpros.connect(proto[1], proto[2]) as sock:
+        tcpros.write_header(sock, {"callerid": "/test", "topic": "/typed2", "md5sum": "*",
+                                   "type": "*"})
+        header = tcpros.read_header(sock)
+        assert header["type"] == "std_msgs/String"
+        assert header["md5sum"] == "992ce8a1687cec8c8bd883ec73ca41d1"
+        assert "string data" in header["message_definition"]
+        body = tcpros.read_message(sock)
+    assert body == b"\x01\x00\x00\x00x"
+
+
+def test_subscriber_survives_dead_publisher_and_reconnects_when_it_returns(nodes):
+    sub = nodes.start("sub.py", "flaky", "std_msgs/String")
+    sub.ready()
+    first = nodes.start("pub.py", "flaky", "std_msgs/String", "data: first", "--name", "talker")
+    first.ready()
+    assert sub.messages() == {"data": "first"}
+    first.signal(signal.SIGKILL)  # dies without unregistering
+    first.wait()
+    time.sleep(0.5)
+    assert sub.proc.poll() is None
+    second = nodes.start("pub.py", "flaky", "std_msgs/String", "data: second", "--name", "talker")
+    second.ready()
+    sub.expect(lambda d: d.get("msg") == {"data": "second"})
+
+
+def test_remaps_namespace_and_private_params_from_argv(nodes, master):
+    xmlrpc.client.ServerProxy(master.uri).setParam("/test", "/robot/shared", 3)
+    proc = nodes.start("names_node.py", "extra", "chatter:=/remapped", "_rate:=5.5",
+                       "_label:=[a, b]", "__ns:=/robot", "__name:=renamed")
+    report = proc.expect(lambda d: "name" in d)
+    assert report["name"] == "/robot/renamed"
+    assert report["namespace"] == "/robot/"
+    assert report["chatter"] == "/remapped"
+    assert report["private"] == "/robot/renamed/x"
+    assert report["global"] == "/abs"
+    assert report["argv"] == ["extra"]
+    assert report["rate"] == 5.5
+    assert report["label"] == ["a", "b"]
+    assert report["missing"] == "dflt"
+    assert report["search"] == "/robot/shared"
+
+
+def test_ros_namespace_environment_places_the_node(nodes):
+    proc = nodes.start("names_node.py", env={"ROS_NAMESPACE": "/ns1"})
+    report = proc.expect(lambda d: "name" in d)
+    assert report["name"] == "/ns1/namer"
+    assert report["chatter"] == "/ns1/chatter"
+
+
+def test_node_name_clash_shuts_down_the_older_node(nodes):
+    older = nodes.start("sub.py", "clash", "std_msgs/String", "--name", "twin")
+    older.ready()
+    newer = nodes.start("sub.py", "clash", "std_msgs/String", "--name", "twin")
+    newer.ready()
+    older.expect(lambda d: d.get("shutdown"))
+    assert older.wait() == 0
+    assert newer.proc.poll() is None
+
+
+def test_sigterm_unregisters_everything_from_the_master(nodes, master):
+    pub = nodes.start("pub.py", "bye", "std_msgs/String", "data: x", "--name", "leaver")
+    pub.ready()
+    assert "/leaver" in publishers_of(master.uri, "/bye")
+    pub.signal(signal.SIGTERM)
+    assert pub.wait() == 0
+    state = system_state(master.uri)
+    assert all("/leaver" not in nodes_ for group in state for _, nodes_ in group)
+
+
+def test_service_calls_plain_persistent_probe_and_handler_error(nodes, master, monkeypatch):
+
+    srv = nodes.start("adder.py", "add")
+    assert srv.ready()["service"] == "/add"
+    m = xmlrpc.client.ServerProxy(master.uri)
+    uri = m.lookupService("/test", "/add")[2]
+    host, port = tcpros.parse_rosrpc_uri(uri)
+    from orchestra.node.msg import Registry
+    monkeypatch.setenv("ROS_PACKAGE_PATH", nodes.env["ROS_PACKAGE_PATH"])
+    cls = Registry().service_class("test_msgs/AddTwoInts")
+    req = cls.Request(a=2, b=40).serialize_bytes()
+
+    # probe: header only, then the server closes
+    with tcpros.connect(host, port) as sock:
+        tcpros.write_header(sock, {"callerid": "/test", "service": "/add", "md5sum": "*",
+                                   "probe": "1"})
+        header = tcpros.read_header(sock)
+        assert header["type"] == "test_msgs/AddTwoInts"
+        assert header["md5sum"] == cls._md5sum == "6a2e34150c00229791cc89ff309fff21"
+        assert sock.recv(1) == b""
+
+    # plain: one call per connection
+    with tcpros.connect(host, port) as sock:
+        tcpros.write_header(sock, {"callerid": "/test", "service": "/add",
+                                   "md5sum": cls._md5sum})
+        tcpros.read_header(sock)
+        tcpros.send_message(sock, req)
+        ok, body = tcpros.read_service_response(sock)
+        assert ok and cls.Response.deserialize_bytes(body).sum == 42
+        assert sock.recv(1) == b""
+
+    # persistent: many calls, and a handler error keeps the connection usable
+    with tcpros.connect(host, port) as sock:
+        tcpros.write_header(sock, {"callerid": "/test", "service": "/add",
+                                   "md5sum": cls._md5sum, "persistent": "1"})
+        tcpros.read_header(sock)
+        for a in range(3):
+            tcpros.send_message(sock, cls.Request(a=a, b=1).serialize_bytes())
+            ok, body = tcpros.read_service_response(sock)
+            assert ok and cls.Response.deserialize_bytes(body).sum == a + 1
+        tcpros.send_message(sock, cls.Request(a=-1, b=1).serialize_bytes())
+        ok, body = tcpros.read_service_response(sock)
+        assert not ok and b"negative a" in body
+        tcpros.send_message(sock, req)
+        ok, body = tcpros.read_service_response(sock)
+        assert ok
+
+    # wrong md5: refused with an error header; the service keeps serving
+    with tcpros.connect(host, port) as sock:
+        tcpros.write_header(sock, {"callerid": "/test", "service": "/add", "md5sum": "f" * 32})
+        assert "error" in tcpros.read_header(sock)
+    assert srv.proc.poll() is None
+    wait_for(lambda: any("refused" in line for line in srv.stderr_lines))
+
+
+def test_service_proxy_from_a_node_process(nodes):
+    nodes.start("adder.py", "math/add").ready()
+    caller = nodes.start("caller.py", "math/add")
+    report = caller.expect(lambda d: "plain" in d)
+    assert report == {"plain": 5, "persistent": [1, 2, 3], "error": True,
+                      "missing": True, "timeout": True}
+
+
+def test_slave_api_reports_pid_publications_subscriptions_and_bus_info(nodes, master):
+    pub = nodes.start("pub.py", "info_topic", "std_msgs/String", "data: x", "--name", "infopub")
+    pub.ready()
+    sub = nodes.start("sub.py", "info_topic", "std_msgs/String", "--name", "infosub")
+    sub.ready()
+    sub.messages()
+    m = xmlrpc.client.ServerProxy(master.uri)
+    api = xmlrpc.client.ServerProxy(m.lookupNode("/test", "/infopub")[2])
+    assert api.getPid("/test") == [1, "", pub.proc.pid]
+    assert ["/info_topic", "std_msgs/String"] in api.getPublications("/test")[2]
+    assert api.getMasterUri("/test")[2] == master.uri
+    info = api.getBusInfo("/test")[2]
+    assert any(row[1] == "/infosub" and row[2] == "o" and row[4] == "/info_topic" for row in info)
+    stats = api.getBusStats("/test")[2]
+    assert any(row[0] == "/info_topic" and row[1] > 0 for row in stats[0])
+    sub_api = xmlrpc.client.ServerProxy(m.lookupNode("/test", "/infosub")[2])
+    assert sub_api.getSubscriptions("/test")[2] == [["/info_topic", "std_msgs/String"]]
+    assert sub_api.requestTopic("/test", "/nope", [["TCPROS"]])[0] == -1
+    # publisherUpdate is idempotent: repeating the current list changes nothing
+    pubs = [m.lookupNode("/test", "/infopub")[2]]
+    assert sub_api.publisherUpdate("/master", "/info_topic", pubs)[0] == 1
+    assert sub_api.publisherUpdate("/master", "/info_topic", pubs)[0] == 1
+    sub.messages()
+    rows = [r for r in sub_api.getBusInfo("/test")[2] if r[4] == "/info_topic"]
+    assert len(rows) == 1 and rows[0][2] == "i"
+    assert api.shutdown("/test", "bye")[0] == 1
+    assert pub.wait() == 0
