@@ -250,3 +250,16 @@ def test_process_index_is_built_once_and_rebuilt_when_path_changes(monkeypatch, 
     monkeypatch.setenv("ROS_PACKAGE_PATH", str(tmp_path / "b"))
     assert find_package("pb") == str(tmp_path / "b" / "pb")
     assert get_index() is not first
+
+
+def test_cache_directory_is_pruned_to_the_most_recent_files(tmp_path, monkeypatch):
+    monkeypatch.setattr(cache, "MAX_FILES", 5)
+    monkeypatch.setattr(cache, "KEEP_FILES", 3)
+    cache_dir = str(tmp_path / "cache")
+    for i in range(5):
+        assert cache.save(cache_dir, f"/root/{i}", {})
+        os.utime(cache.cache_file(cache_dir, f"/root/{i}"), (OLD + i, OLD + i))
+    assert cache.save(cache_dir, "/root/new", {})
+    left = sorted(os.listdir(cache_dir))
+    expected = ["/root/new", "/root/4", "/root/3"]
+    assert left == sorted(os.path.basename(cache.cache_file(cache_dir, r)) for r in expected)

@@ -16,7 +16,6 @@ import hashlib
 import json
 import logging
 import os
-import tempfile
 from typing import Mapping
 
 from orchestra.packages.crawl import Record
@@ -24,6 +23,11 @@ from orchestra.packages.crawl import Record
 log = logging.getLogger(__name__)
 
 FORMAT = 1
+
+#: one file per root ever crawled would grow without bound (every test's temporary tree);
+#: past MAX_FILES the least recently written files go, down to KEEP_FILES
+MAX_FILES = 200
+KEEP_FILES = 100
 
 
 def default_cache_dir(environ: Mapping[str, str] | None = None) -> str | None:
@@ -66,6 +70,8 @@ def save(cache_dir: str | None, root: str, records: dict[str, Record]) -> bool:
     """Atomically replace the cache file of ``root``; False (and no exception) on failure."""
     if cache_dir is None:
         return False
+    import tempfile  # only writers pay for it
+
     tmp = None
     try:
         os.makedirs(cache_dir, exist_ok=True)
@@ -74,6 +80,7 @@ def save(cache_dir: str | None, root: str, records: dict[str, Record]) -> bool:
             json.dump({"format": FORMAT, "root": root, "records": records}, fh,
                       separators=(",", ":"))
         os.replace(tmp, cache_file(cache_dir, root))
+        _prune(cache_dir)
         return True
     except OSError as exc:
         log.debug("cannot write package cache in %s: %s", cache_dir, exc)
@@ -83,3 +90,17 @@ def save(cache_dir: str | None, root: str, records: dict[str, Record]) -> bool:
             except OSError:
                 pass
         return False
+
+
+def _prune(cache_dir: str) -> None:
+    """Drop the least recently written cache files once there are too many."""
+    try:
+        names = [n for n in os.listdir(cache_dir) if n.startswith("packages-")]
+        if len(names) <= MAX_FILES:
+            return
+        paths = [os.path.join(cache_dir, n) for n in names]
+        aged = sorted(paths, key=lambda p: os.stat(p).st_mtime_ns)
+        for path in aged[:len(aged) - KEEP_FILES]:
+            os.unlink(path)
+    except OSError as exc:  # another process pruning at the same time
+        log.debug("cache pruning in %s: %s", cache_dir, exc)
