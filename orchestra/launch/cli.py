@@ -110,9 +110,17 @@ def _node_args(plan: Any, name: str) -> str:
     return " ".join([*env, *(shlex.quote(a) for a in entry["argv"])])
 
 
-def _ros_args(interp: Any) -> str:
-    required = [a for a in interp.root_args if not a.default]
-    optional = [a for a in interp.root_args if a.default]
+def _ros_args(paths: list[str], args: dict[str, str]) -> str:
+    from orchestra.launch.interpreter import declared_args, parse_launch_file
+    declared = []
+    for path in paths:
+        if path == "-":
+            from orchestra.launch.xml import parse_string
+            declared += declared_args(parse_string(sys.stdin.read(), "<stdin>"), "<stdin>", args)
+        else:
+            declared += declared_args(parse_launch_file(path), path, args)
+    required = [a for a in declared if not a.default]
+    optional = [a for a in declared if a.default]
     if not required and not optional:
         return "No arguments."
     lines = []
@@ -144,8 +152,11 @@ def launch(words: tuple[str, ...], dump_plan: bool, dump_params: bool, nodes: bo
            no_exec: bool, **run_opts: Any) -> None:
     """Resolve and run a roslaunch file: orchestra launch [PKG] FILE [name:=value ...]."""
     paths, args = split_words(words)
-    list_mode = nodes or bool(node_args) or files or bool(find_node)
-    interp = _interpret(paths, args, no_exec=no_exec, roscore=list_mode)
+    if ros_args:
+        click.echo(_ros_args(paths, args))
+        return
+    # like roslaunch, everything but the two dumps loads roscore.xml's params first
+    interp = _interpret(paths, args, no_exec=no_exec, roscore=not (dump_plan or dump_params))
     plan = interp.plan()
     if dump_plan:
         click.echo(_dump_json(plan))
@@ -170,8 +181,6 @@ def launch(words: tuple[str, ...], dump_plan: bool, dump_params: bool, nodes: bo
     elif find_node:
         node = _find_node(plan, find_node)
         click.echo(node.filename or "")
-    elif ros_args:
-        click.echo(_ros_args(interp))
     else:
         from orchestra.supervise.cli import run_plan
         options = dict(run_opts)

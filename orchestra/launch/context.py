@@ -30,14 +30,13 @@ class Scope:
     """One level of loader scope (see the module docstring for the rules)."""
 
     __slots__ = ("parent", "ns", "filename", "remaps", "params", "env_args", "args",
-                 "arg_docs", "arg_names", "include_args", "pass_all_args", "args_passed",
+                 "arg_names", "include_args", "pass_all_args", "args_passed",
                  "include_stack", "pending_filename")
 
     def __init__(self, ns: str, filename: str | None, parent: "Scope | None" = None,
                  params: list[tuple[str, Any]] | None = None,
                  env_args: list[tuple[str, str]] | None = None,
                  args: dict[str, str] | None = None,
-                 arg_docs: dict[str, tuple[str | None, str | None]] | None = None,
                  arg_names: list[str] | None = None,
                  include_args: dict[str, str] | None = None,
                  pass_all_args: bool = False,
@@ -49,7 +48,6 @@ class Scope:
         self.params = params if params else []
         self.env_args = env_args if env_args is not None else []
         self.args = args if args is not None else {}
-        self.arg_docs = arg_docs if arg_docs is not None else {}
         self.arg_names = arg_names if arg_names is not None else []
         self.include_args = include_args
         self.pass_all_args = pass_all_args
@@ -74,7 +72,7 @@ class Scope:
             child_ns = self.ns
         return Scope(child_ns, self.filename, parent=self, params=self.params,
                      env_args=list(self.env_args), args=dict(self.args),
-                     arg_docs=dict(self.arg_docs), arg_names=list(self.arg_names),
+                     arg_names=list(self.arg_names),
                      include_args=self.include_args, pass_all_args=self.pass_all_args,
                      include_stack=self.include_stack)
 
@@ -115,8 +113,7 @@ class Scope:
         return inherited + self.remaps
 
     # ------------------------------------------------------------------ args
-    def add_arg(self, name: str, default: str | None = None, value: str | None = None,
-                doc: str | None = None) -> None:
+    def add_arg(self, name: str, default: str | None = None, value: str | None = None) -> None:
         if name in self.arg_names:
             if not self.pass_all_args:
                 raise ScopeError(f"arg '{name}' has already been declared")
@@ -130,8 +127,6 @@ class Scope:
         elif default is not None:
             if name not in target:
                 target[name] = default
-        if not value and self.include_args is None:
-            self.arg_docs[name] = (doc, default)
 
     def enter_include(self) -> None:
         """Switch from reading ``<include>``'s children to reading the included file."""
@@ -145,7 +140,6 @@ class Scope:
             self.pending_filename = None
         self.arg_names = []
         self.args = passed
-        self.arg_docs = {}
         self.include_args = None
 
     def unused_include_args(self) -> list[str]:

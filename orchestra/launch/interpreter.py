@@ -101,7 +101,6 @@ class Interpreter:
         self.machines: dict[str, Machine] = {"": Machine(name="")}
         self.files: list[str] = []
         self.warnings: list[str] = []
-        self.root_args: list[ArgInfo] = []
         self._node_names: dict[str, Location] = {}
         self._parse: Callable[[str], Entity] = parse_launch_file
 
@@ -122,10 +121,6 @@ class Interpreter:
         scope.args = dict(self.options.args)
         self._check_launch_tag(root, scope)
         self._children(root.children, scope, None)
-        for name in scope.arg_names:
-            doc, default = scope.arg_docs.get(name, (None, None))
-            if name in scope.arg_docs:
-                self.root_args.append(ArgInfo(name, doc, default))
 
     def plan(self) -> LaunchPlan:
         return LaunchPlan(params=self.params, clear_params=tuple(self.clear_params),
@@ -258,11 +253,11 @@ class Interpreter:
             return None
         self._check_attrs(entity, ARG_ATTRS)
         (name,) = self._req(entity, scope, "name")
-        value, default, doc = self._opt(entity, scope, "value", "default", "doc")
+        value, default, _doc = self._opt(entity, scope, "value", "default", "doc")
         if value is not None and default is not None:
             raise self._error(entity, "<arg> may have only one of value/default")
         try:
-            scope.add_arg(name, default=default, value=value, doc=doc)
+            scope.add_arg(name, default=default, value=value)
         except ScopeError as exc:
             raise self._error(entity, str(exc), "name") from None
         return None
@@ -686,6 +681,36 @@ _TAGS: dict[str, Callable[..., Any]] = {
     "env": Interpreter._env,
     "arg": Interpreter._arg,
 }
+
+
+def declared_args(root: Entity, filename: str, args: dict[str, str] | None = None
+                  ) -> list[ArgInfo]:
+    """The top-level ``<arg>``s of a launch file without interpreting it (``--ros-args``).
+
+    Like roslaunch's args-only mode this must work when required args are missing, so a
+    substitution that cannot be resolved is shown as written.
+    """
+    scope = Scope(os.environ.get("ROS_NAMESPACE", "/") or "/", filename)
+    scope.args = dict(args or {})
+    found: list[ArgInfo] = []
+    for entity in root.children:
+        if entity.tag != "arg" or "name" not in entity.attributes:
+            continue
+        values = {}
+        for attr in ("name", "value", "default", "doc"):
+            raw = entity.attributes.get(attr)
+            try:
+                values[attr] = resolve(raw, scope)
+            except OrchestraError:
+                values[attr] = raw
+        if values["value"] is not None:
+            scope.args.setdefault(values["name"], values["value"])
+            if values["value"]:
+                continue
+        elif values["default"] is not None:
+            scope.args.setdefault(values["name"], values["default"])
+        found.append(ArgInfo(values["name"], values["doc"], values["default"]))
+    return found
 
 
 def load_launch(path: str, args: dict[str, str] | None = None, *, no_exec: bool = False,
