@@ -204,8 +204,9 @@ def parse_create_args(argv: list[str]) -> tuple[dict, str]:
     return fields, directory
 
 
-@click.command(help=CREATE_HELP, context_settings={"ignore_unknown_options": True,
-                                                   "help_option_names": ["-h", "--help"]})
+@click.command(help=CREATE_HELP, options_metavar="",
+               context_settings={"ignore_unknown_options": True,
+                                 "help_option_names": ["-h", "--help"]})
 @click.argument("argv", nargs=-1, type=click.UNPROCESSED, metavar="NAME [DEPS...] [OPTIONS]")
 def create_pkg(argv: tuple[str, ...]) -> None:
     from orchestra.packages.create import PackageRequest, create_package
