@@ -1,0 +1,86 @@
+"""``orchestra launch`` dump modes, through the real command line."""
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+
+@pytest.fixture
+def ws(tmp_path):
+    pkg = tmp_path / "ws" / "demo"
+    (pkg / "launch" / "sub").mkdir(parents=True)
+    (pkg / "package.xml").write_text("<package><name>demo</name></package>")
+    (pkg / "launch" / "sub" / "main.launch").write_text(
+        '<launch>\n  <arg name="rate" default="10" doc="publish rate"/>\n'
+        '  <arg name="robot"/>\n'
+        '  <param name="rate" value="$(arg rate)"/>\n'
+        '  <param name="robot" value="$(arg robot)"/>\n'
+        '  <param name="blob" binfile="$(dirname)/main.launch"/>\n'
+        '  <group ns="g"><node name="talker" pkg="demo" type="talk" args="-v"/></group>\n'
+        '  <include file="$(dirname)/inc.launch"/>\n</launch>\n')
+    (pkg / "launch" / "sub" / "inc.launch").write_text(
+        '<launch><node name="listener" pkg="demo" type="listen"/></launch>\n')
+    return tmp_path / "ws"
+
+
+def orchestra(ws, *words, stdin=None):
+    env = {"PATH": os.environ["PATH"], "ROS_PACKAGE_PATH": str(ws), "ROS_DISTRO": "noetic",
+           "ROS_HOME": str(ws / ".ros")}
+    return subprocess.run([sys.executable, "-m", "orchestra", "launch", *words], env=env,
+                          input=stdin, capture_output=True, text=True, timeout=60)
+
+
+@pytest.mark.timeout(120)
+def test_pkg_file_form_finds_the_file_anywhere_in_the_package(ws):
+    proc = orchestra(ws, "demo", "main.launch", "robot:=pr2", "--nodes")
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.split() == ["/g/talker", "/listener"]
+
+
+@pytest.mark.timeout(120)
+def test_dump_plan_is_json_with_binary_params_and_cli_args(ws):
+    proc = orchestra(ws, "demo", "main.launch", "robot:=pr2", "rate:=5", "3d:=x",
+                     "--dump-plan", "--no-exec")
+    assert proc.returncode == 0, proc.stderr
+    plan = json.loads(proc.stdout)
+    assert plan["params"]["/rate"] == 5
+    assert set(plan["params"]["/blob"]) == {"__binary_b64__"}
+    assert [n["name"] for n in plan["nodes"]] == ["talker", "listener"]
+    assert len(plan["files_loaded"]) == 2
+
+
+@pytest.mark.timeout(120)
+def test_dump_params_prints_yaml_without_roscore_params(ws):
+    import yaml
+    proc = orchestra(ws, "demo", "main.launch", "robot:=x", "--dump-params")
+    assert proc.returncode == 0, proc.stderr
+    params = yaml.safe_load(proc.stdout)
+    assert params["/rate"] == 10 and "/rosversion" not in params
+
+
+@pytest.mark.timeout(120)
+def test_files_find_node_and_ros_args(ws):
+    files = orchestra(ws, "demo", "main.launch", "robot:=x", "--files")
+    assert [os.path.basename(f) for f in files.stdout.split()] == ["main.launch", "inc.launch"]
+    found = orchestra(ws, "demo", "main.launch", "robot:=x", "--find-node", "/listener")
+    assert found.stdout.strip().endswith("inc.launch")
+    args = orchestra(ws, "demo", "main.launch", "--ros-args")
+    assert args.returncode == 0, args.stderr
+    assert "Required Arguments:\n  robot: undocumented" in args.stdout
+    assert '  rate (default "10"): publish rate' in args.stdout
+
+
+@pytest.mark.timeout(120)
+def test_missing_required_arg_is_a_located_error(ws):
+    proc = orchestra(ws, "demo", "main.launch", "--dump-plan")
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr
+    assert "main.launch:5" in proc.stderr and "'robot'" in proc.stderr
+
+
+@pytest.mark.timeout(120)
+def test_stdin_launch_file(ws):
+    proc = orchestra(ws, "-", "--dump-params", stdin='<launch><param name="x" value="1"/></launch>')
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip() == "/x: 1"
