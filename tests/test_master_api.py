@@ -405,3 +405,27 @@ def test_upload_params_unreachable_master_is_user_error():
     handle.shutdown()
     with pytest.raises(OrchestraError, match="cannot reach"):
         upload_params(handle.uri, {"/a": 1}, [])
+
+
+def test_in_process_param_write_notifies_subscribed_nodes(master, m, slaves):
+    s = slaves()
+    m.subscribeParam("/node", s.uri, "/tuning")
+    master.params.set("/tuning/kp", 0.5)
+    assert s.wait_for(1) == [("paramUpdate", "/master", "/tuning/kp/", 0.5)]
+
+
+def test_param_updates_to_one_node_arrive_in_write_order(master, m, slaves):
+    s = slaves()
+    m.subscribeParam("/node", s.uri, "/count")
+    for i in range(20):
+        m.setParam("/writer", "/count", i)
+    assert [c[3] for c in s.wait_for(20)] == list(range(20))
+
+
+def test_replaced_node_loses_its_param_subscriptions(master, m, slaves):
+    old, new = slaves(), slaves()
+    m.subscribeParam("/node", old.uri, "/p")
+    m.registerSubscriber("/node", "/t", "std_msgs/Int32", new.uri)
+    m.setParam("/w", "/p", 1)
+    assert master.api.notifier.wait_idle(5)
+    assert [c[0] for c in old.calls] == ["shutdown"]

@@ -119,6 +119,7 @@ class MasterAPI:
                  on_shutdown: Callable[[str], None] | None = None):
         self.uri = uri
         self.params = params if params is not None else ParamTree()
+        self.params.listener = self._notify_params
         self.reg = Registrations()
         self.notifier = notifier if notifier is not None else Notifier()
         self.on_shutdown = on_shutdown
@@ -256,14 +257,14 @@ class MasterAPI:
     def getPublishedTopics(self, caller_id: str, subgraph: str) -> Result:
         if subgraph and not subgraph.endswith(SEP):
             subgraph += SEP
-        with self.reg.lock:
+        with self._lock:
             topics = [[t, self.reg.topic_types.get(t, ANYTYPE)]
                       for t in self.reg.topics[PUBLISHER] if t.startswith(subgraph)]
         return 1, "current topics", topics
 
     @_api(0)
     def getTopicTypes(self, caller_id: str) -> Result:
-        with self.reg.lock:
+        with self._lock:
             types = [[t, ty] for t, ty in self.reg.topic_types.items()]
         return 1, "current system state", types
 
@@ -278,10 +279,9 @@ class MasterAPI:
         key = resolve(key, caller_id)
         with self._lock:
             try:
-                updates = self.params.delete(key)
+                self.params.delete(key)  # the tree's listener notifies subscribers
             except KeyError:
                 return -1, f"parameter [{key}] is not set", 0
-            self._notify_params(updates)
         return 1, f"parameter {key} deleted", 0
 
     @_api(0, _non_empty_str("key"), _not_none("value"))
@@ -293,10 +293,9 @@ class MasterAPI:
             return -1, exc.message, 0
         with self._lock:
             try:
-                updates = self.params.set(key, value)
+                self.params.set(key, value)  # the tree's listener notifies subscribers
             except TypeError as exc:
                 return -1, str(exc), 0
-            self._notify_params(updates)
         return 1, f"parameter {key} set", 0
 
     @_api(0, _non_empty_str("key"))

@@ -18,7 +18,7 @@ import datetime
 import threading
 import xmlrpc.client
 from dataclasses import dataclass
-from typing import Any, Iterator
+from typing import Any, Callable, Iterator
 
 from orchestra.errors import Location, OrchestraError
 
@@ -160,13 +160,16 @@ class ParamTree:
     """A thread-safe hierarchical parameter store with rosmaster's exact semantics.
 
     All methods take global names. Reads return copies of dict subtrees, so a caller may
-    keep, marshal or mutate a result while other threads write.
+    keep, marshal or mutate a result while other threads write. ``listener`` (the master's
+    notifier) receives the updates of every write, in write order, whoever made the write:
+    an in-process ``tree.set`` reaches subscribed nodes just like an XML-RPC ``setParam``.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, listener: Callable[[list[ParamUpdate]], None] | None = None) -> None:
         self._root: dict[str, Any] = {}
         self._subscribers: dict[str, list[tuple[str, str]]] = {}
         self._lock = threading.RLock()
+        self.listener = listener
 
     # reads -----------------------------------------------------------------------------------
 
@@ -252,7 +255,7 @@ class ParamTree:
                         child = d[part] = {}
                     d = child
                 d[parts[-1]] = value
-            return self._updates(key, value)
+            return self._announce(self._updates(key, value))
 
     def delete(self, key: str) -> list[ParamUpdate]:
         """Remove ``key`` (a leaf or a whole namespace); KeyError when it is not set."""
@@ -268,7 +271,7 @@ class ParamTree:
             if not isinstance(d, dict) or parts[-1] not in d:
                 raise KeyError(key)
             del d[parts[-1]]
-            return self._updates(key, {})
+            return self._announce(self._updates(key, {}))
 
     # subscriptions ---------------------------------------------------------------------------
 
@@ -312,6 +315,11 @@ class ParamTree:
         with self._lock:
             return [k for k, nodes in self._subscribers.items()
                     if any(n[0] == caller_id for n in nodes)]
+
+    def _announce(self, updates: list[ParamUpdate]) -> list[ParamUpdate]:
+        if updates and self.listener is not None:
+            self.listener(updates)
+        return updates
 
     def _updates(self, key: str, value: Any) -> list[ParamUpdate]:
         """The paramUpdates a write of ``value`` at ``key`` causes (rosmaster's rules).
