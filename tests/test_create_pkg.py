@@ -191,3 +191,41 @@ def test_python_node_is_found_as_the_launch_files_executable(tmp_path, monkeypat
         assert find_executable("hello_pkg", "hello") == str(src / "hello_pkg" / "scripts" / "hello")
     finally:
         reset_index()
+
+
+@pytest.mark.timeout(90)
+def test_python_node_package_launches_at_once_and_stops_cleanly(tmp_path):
+    """create-pkg --python-node, then `orchestra launch NAME NAME.launch` runs the node."""
+    import select
+    import signal
+    import time
+
+    src = tmp_path / "ws" / "src"
+    src.mkdir(parents=True)
+    assert orchestra_make(["hello_pkg", "rospy", "std_msgs", "--python-node", "hello"], src).returncode == 0
+    env = {k: v for k, v in ENV.items() if k not in ("ROS_PACKAGE_PATH", "ROS_MASTER_URI")}
+    env["ROS_HOME"] = str(tmp_path / "ros_home")
+    proc = subprocess.Popen([*ORCHESTRA, "launch", "-p", "0", "hello_pkg", "hello_pkg.launch"],
+                            cwd=src, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                            text=True, start_new_session=True)
+    output = []
+    try:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline:
+            ready, _, _ = select.select([proc.stdout], [], [], 1.0)
+            if ready:
+                line = proc.stdout.readline()
+                if not line:
+                    break
+                output.append(line)
+                if "hello from hello_pkg #0" in line:
+                    break
+        assert any("hello from hello_pkg #0" in line for line in output), "".join(output)
+        proc.send_signal(signal.SIGINT)
+        rest, _ = proc.communicate(timeout=30)
+        output.append(rest)
+        assert "Traceback" not in "".join(output)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
