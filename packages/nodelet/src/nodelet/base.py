@@ -13,6 +13,7 @@ import threading
 from typing import Any, Callable
 
 from nodelet import names
+from nodelet.local import BUS, NodeletPublisher
 
 _MISSING = object()
 
@@ -24,7 +25,7 @@ class Timer:
         self.period = period
         self.callback = callback
         self._stop = threading.Event()
-        self._log = logging.getLogger(name)
+        self._log = NodeletLog(name)
         self._thread = threading.Thread(target=self._run, name=f"timer:{name}", daemon=True)
         self._thread.start()
 
@@ -47,6 +48,42 @@ class Timer:
         self._stop.set()
 
 
+class NodeletLog:
+    """``info/warning/error/exception`` that reach /rosout through the hosting process's node
+    (prefixed with the nodelet's name, since every nodelet shares that node), or plain
+    ``logging`` when no node runs (unit tests)."""
+
+    def __init__(self, name: str):
+        self.name = name
+        self._logger = logging.getLogger(name)
+
+    def _emit(self, level: str, msg: str, args: tuple) -> None:
+        try:
+            from orchestra import node
+            node.get_name()
+        except Exception:
+            getattr(self._logger, {"logerr": "error", "logwarn": "warning"}.get(
+                level, "info" if level == "loginfo" else "debug"))(msg, *args)
+            return
+        getattr(node, level)("[%s] " + msg, self.name, *args)
+
+    def debug(self, msg: str, *args: Any) -> None:
+        self._emit("logdebug", msg, args)
+
+    def info(self, msg: str, *args: Any) -> None:
+        self._emit("loginfo", msg, args)
+
+    def warning(self, msg: str, *args: Any) -> None:
+        self._emit("logwarn", msg, args)
+
+    def error(self, msg: str, *args: Any) -> None:
+        self._emit("logerr", msg, args)
+
+    def exception(self, msg: str, *args: Any) -> None:
+        import traceback
+        self._emit("logerr", msg + "\n%s", args + (traceback.format_exc(),))
+
+
 class Nodelet:
     """Subclass and override ``on_init`` (roscpp's ``onInit``): create publishers,
     subscribers, services and timers there through the helpers below."""
@@ -57,7 +94,7 @@ class Nodelet:
         self.namespace = names.namespace_of(self.name)
         self.remaps = dict(remaps or {})
         self.my_argv = list(my_argv or [])
-        self.log = logging.getLogger(self.name)
+        self.log = NodeletLog(self.name)
         self._handles: list[Any] = []
         self._timers: list[Timer] = []
         self._lock = threading.Lock()
@@ -94,14 +131,17 @@ class Nodelet:
     def advertise(self, topic: str, msg_class: type, queue_size: int = 10,
                   latch: bool = False) -> Any:
         from orchestra import node
-        return self._keep(node.Publisher(self.resolve(topic), msg_class,
-                                         queue_size=queue_size, latch=latch))
+        resolved = self.resolve(topic)
+        remote = node.Publisher(resolved, msg_class, queue_size=queue_size, latch=latch)
+        return self._keep(NodeletPublisher(remote, resolved, latch))
 
     def subscribe(self, topic: str, msg_class: type, callback: Callable[[Any], None],
                   queue_size: int = 10) -> Any:
         from orchestra import node
-        return self._keep(node.Subscriber(self.resolve(topic), msg_class, callback,
-                                          queue_size=queue_size))
+        resolved = self.resolve(topic)
+        # other nodelets of this process publish through the local bus, the rest over TCPROS
+        self._keep(BUS.subscribe(resolved, msg_class._type, callback, queue_size))
+        return self._keep(node.Subscriber(resolved, msg_class, callback, queue_size=queue_size))
 
     def advertise_service(self, name: str, srv_class: type,
                           handler: Callable[[Any], Any]) -> Any:

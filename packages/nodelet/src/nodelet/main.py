@@ -50,7 +50,8 @@ def run_manager() -> int:
     def on_unload(req):
         ok = manager.unload(req.name)
         if not ok:
-            node.logwarn("unload of unknown nodelet '%s'", req.name)
+            # normal while shutting down: the manager unloads everything before loaders ask
+            node.logdebug("unload of unknown nodelet '%s'", req.name)
         return unload_cls.Response(success=ok)
 
     def on_list(_req):
@@ -163,7 +164,7 @@ def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     words = names.strip_ros_args(argv)
     if not words:
-        print(USAGE, file=sys.stderr)
+        sys.stderr.write(USAGE + "\n")
         return 2
     command, rest = words[0], words[1:]
     try:
@@ -176,7 +177,7 @@ def main(argv: list[str] | None = None) -> int:
         if command == "unload" and len(rest) >= 2:
             return run_unload(rest[0], rest[1])
     except OrchestraError as exc:
-        print(f"nodelet: error: {exc}", file=sys.stderr)
+        sys.stderr.write(f"nodelet: error: {exc}\n")
         return exc.exit_code
-    print(USAGE, file=sys.stderr)
+    sys.stderr.write(USAGE + "\n")
     return 2
