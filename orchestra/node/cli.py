@@ -1,0 +1,523 @@
+"""``orchestra node|topic|service|graph``: rosnode/rostopic/rosservice/rqt_graph, in one CLI.
+
+Output follows the ROS tools' conventions (``topic echo`` prints each message as YAML then a
+``---`` line; ``topic hz`` prints ``average rate`` blocks), so scripts written against them
+keep working. Everything goes through the master at ROS_MASTER_URI, which may be orchestra's
+or a real rosmaster.
+"""
+from __future__ import annotations
+
+import math
+import queue
+import time
+
+import click
+import yaml
+
+from orchestra.errors import OrchestraError
+from orchestra.node import introspect
+from orchestra.node.exceptions import ROSException
+
+CLI_NODE = "orchestra_cli"
+
+
+class CommandFailed(OrchestraError):
+    """The command ran but what it asked for failed (a service error, ...): exit 1."""
+
+    exit_code = 1
+
+
+def _master_uri() -> str:
+    from orchestra.master import master_uri_from_env
+    return master_uri_from_env()
+
+
+def _require_master(uri: str) -> None:
+    from orchestra.master import MasterUnreachable, master_is_up
+    if not master_is_up(uri, timeout=2.0):
+        raise MasterUnreachable(f"cannot contact the master at {uri} (is it running? "
+                                "check ROS_MASTER_URI)")
+
+
+def _global(name: str) -> str:
+    from orchestra.node.names import canonical, is_legal_name
+    if not is_legal_name(name) or name.startswith("~"):
+        raise OrchestraError(f"illegal graph name '{name}'")
+    return canonical(name if name.startswith("/") else "/" + name)
+
+
+def _parse_yaml(texts: tuple[str, ...], what: str):
+    """One YAML value from the command-line words (several words = a list of field values)."""
+    try:
+        values = [yaml.safe_load(t) for t in texts]
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" (line {mark.line + 1}, column {mark.column + 1})" if mark else ""
+        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+        raise OrchestraError(f"malformed YAML for {what}{where}: {problem}") from None
+    if not values:
+        return None
+    return values[0] if len(values) == 1 else values
+
+
+def _fill(cls, value, what: str):
+    from orchestra.node.msg import FillError, fill_message
+    try:
+        return fill_message(cls(), value)
+    except (FillError, TypeError, ValueError) as exc:
+        raise OrchestraError(f"cannot build {what} from the given YAML: {exc}") from None
+
+
+def _message_class(type_name: str):
+    from orchestra.node.msg import MessageNotFound, get_message_class
+    from orchestra.node.msgspec import MsgSpecError
+    try:
+        return get_message_class(type_name)
+    except (MessageNotFound, MsgSpecError) as exc:
+        raise OrchestraError(str(exc)) from None
+
+
+def _start_cli_node():
+    """This process as an anonymous node (as rostopic does), without signal handlers."""
+    import orchestra.node as rospy
+    _require_master(_master_uri())
+    rospy.init_node(CLI_NODE, argv=[], anonymous=True, disable_signals=True,
+                    disable_rosout=True)
+    return rospy
+
+
+def _stop_cli_node(reason: str) -> None:
+    from orchestra.node import runtime
+    rt = runtime._runtime
+    if rt is not None:
+        rt.signal_shutdown(reason)
+        rt.wait_shutdown_done()
+        runtime._runtime = None
+
+
+# --- node -------------------------------------------------------------------------------------
+
+@click.group()
+def node() -> None:
+    """Running nodes: list, info, kill (like rosnode)."""
+
+
+@node.command("list")
+def node_list() -> None:
+    """Print every node known to the master."""
+    for name in introspect.system_state(_master_uri()).nodes:
+        click.echo(name)
+
+
+def _bullets(items: list[str]) -> str:
+    return "\n".join(f" * {i}" for i in items) + "\n" if items else ""
+
+
+@node.command("info")
+@click.argument("name")
+def node_info(name: str) -> None:
+    """Publications, subscriptions, services and connections of NAME."""
+    uri_master = _master_uri()
+    name = _global(name)
+    state = introspect.system_state(uri_master)
+    uri = introspect.lookup_node(uri_master, name)
+    click.echo("-" * 80)
+    click.echo(f"Node [{name}]")
+    for title, items in (("Publications", [f"{t} [{state.types.get(t, '*')}]"
+                                           for t in state.node_publications(name)]),
+                         ("Subscriptions", [f"{t} [{state.types.get(t, 'unknown type')}]"
+                                            for t in state.node_subscriptions(name)]),
+                         ("Services", state.node_services(name))):
+        if items:
+            click.echo(f"{title}: \n{_bullets(items)}")
+        else:
+            click.echo(f"{title}: None\n")
+    click.echo(f"\ncontacting node {uri} ...")
+    pid, info = introspect.node_bus_info(uri)
+    if pid is None:
+        click.echo("ERROR: communication with node failed")
+        return
+    click.echo(f"Pid: {pid}")
+    if info:
+        click.echo("Connections:")
+        for _cid, dest, direction, transport, topic, _connected, *_ in info:
+            click.echo(f" * topic: {topic}")
+            click.echo(f"    * to: {dest}")
+            click.echo(f"    * direction: {'outbound' if direction == 'o' else 'inbound'}")
+            click.echo(f"    * transport: {transport}")
+
+
+@node.command("kill")
+@click.argument("names", nargs=-1)
+@click.option("-a", "--all", "kill_all", is_flag=True, help="Kill every node.")
+def node_kill(names: tuple[str, ...], kill_all: bool) -> None:
+    """Ask NAMES to shut down (through their slave API, as rosnode kill does)."""
+    uri = _master_uri()
+    targets = introspect.system_state(uri).nodes if kill_all else [_global(n) for n in names]
+    if not targets:
+        raise OrchestraError("give the node names to kill, or --all")
+    failed = []
+    for name in targets:
+        click.echo(f"killing {name}")
+        try:
+            introspect.kill_node(uri, name)
+        except introspect.GraphError as exc:
+            click.echo(f"ERROR: {exc}", err=True)
+            failed.append(name)
+    if failed:
+        raise CommandFailed(f"could not kill {', '.join(failed)}")
+    click.echo("killed")
+
+
+# --- topic --------------------------------------------------------------------------------------
+
+@click.group()
+def topic() -> None:
+    """Topics: list, info, type, echo, pub, hz (like rostopic)."""
+
+
+@topic.command("list")
+@click.option("-v", "--verbose", is_flag=True, help="Group by publishers and subscribers.")
+def topic_list(verbose: bool) -> None:
+    """Print every topic with a publisher or a subscriber."""
+    state = introspect.system_state(_master_uri())
+    if not verbose:
+        for t in state.topics:
+            click.echo(t)
+        return
+    for title, table in (("Published topics", state.publishers),
+                         ("Subscribed topics", state.subscribers)):
+        click.echo(f"\n{title}:")
+        for t in sorted(table):
+            n = len(table[t])
+            click.echo(f" * {t} [{state.types.get(t, 'unknown type')}] {n} "
+                       f"{'publisher' if title.startswith('Pub') else 'subscriber'}"
+                       f"{'s' if n != 1 else ''}")
+    click.echo("")
+
+
+@topic.command("type")
+@click.argument("name")
+def topic_type(name: str) -> None:
+    """Print the message type of NAME."""
+    name = _global(name)
+    state = introspect.system_state(_master_uri())
+    if name not in state.types:
+        raise OrchestraError(f"unknown topic {name} (nobody publishes it)")
+    click.echo(state.types[name])
+
+
+@topic.command("info")
+@click.argument("name")
+def topic_info(name: str) -> None:
+    """Type, publishers and subscribers of NAME."""
+    name = _global(name)
+    uri = _master_uri()
+    state = introspect.system_state(uri)
+    if name not in state.publishers and name not in state.subscribers:
+        raise OrchestraError(f"unknown topic {name}")
+    click.echo(f"Type: {state.types.get(name, 'unknown type')}\n")
+    for title, table in (("Publishers", state.publishers), ("Subscribers", state.subscribers)):
+        nodes_ = table.get(name, [])
+        if not nodes_:
+            click.echo(f"{title}: None\n")
+            continue
+        click.echo(f"{title}: ")
+        for n in nodes_:
+            try:
+                api = introspect.lookup_node(uri, n)
+            except introspect.GraphError:
+                api = "unknown address"
+            click.echo(f" * {n} ({api})")
+        click.echo("")
+
+
+class _Decoder:
+    """Decode raw messages using the publisher's own definition when ours differs or is
+    missing: echo works for any type, even without its .msg file."""
+
+    def __init__(self):
+        self._classes: dict[tuple[str, str], type] = {}
+
+    def __call__(self, raw):
+        from orchestra.node.msg import MessageNotFound, get_message_class, \
+            message_class_from_definition
+        header = raw._connection_header
+        key = (header.get("type", ""), header.get("md5sum", ""))
+        cls = self._classes.get(key)
+        if cls is None:
+            try:
+                cls = get_message_class(key[0])
+                if cls._md5sum != key[1]:
+                    cls = None
+            except (MessageNotFound, ROSException):
+                cls = None
+            if cls is None:
+                cls = message_class_from_definition(key[0], header.get("message_definition", ""))
+            self._classes[key] = cls
+        return cls.deserialize_bytes(raw._buff)
+
+
+def _subscribe_raw(rospy, name: str):
+    from orchestra.node.msg import AnyMsg
+    inbox: queue.Queue = queue.Queue()
+    sub = rospy.Subscriber(name, AnyMsg, lambda m: inbox.put((time.monotonic(), m)))
+    return sub, inbox
+
+
+@topic.command("echo")
+@click.argument("name")
+@click.option("-n", "count", type=click.IntRange(min=1), default=None,
+              help="Exit after N messages.")
+@click.option("--noarr", is_flag=True, help="Print arrays as their length.")
+def topic_echo(name: str, count: int | None, noarr: bool) -> None:
+    """Print each message on NAME as YAML followed by a '---' line."""
+    from orchestra.node.msg import to_yaml_text
+    name = _global(name)
+    rospy = _start_cli_node()
+    decode = _Decoder()
+    printed = 0
+    try:
+        state = introspect.system_state(_master_uri())
+        if name not in state.publishers:
+            click.echo(f"WARNING: topic [{name}] does not appear to be published yet", err=True)
+        _sub, inbox = _subscribe_raw(rospy, name)
+        while count is None or printed < count:
+            try:
+                _, raw = inbox.get(timeout=0.2)
+            except queue.Empty:
+                continue
+            msg = decode(raw)
+            if noarr:
+                for field_name in msg._fields:
+                    value = getattr(msg, field_name)
+                    if isinstance(value, (list, tuple, bytes)):
+                        setattr(msg, field_name, f"<array of length {len(value)}>")
+            click.echo(to_yaml_text(msg) + "\n---")
+            printed += 1
+    except KeyboardInterrupt:
+        pass
+    finally:
+        _stop_cli_node("topic echo done")
+
+
+@topic.command("pub")
+@click.argument("name")
+@click.argument("type_name", metavar="TYPE")
+@click.argument("values", nargs=-1)
+@click.option("-r", "--rate", type=float, default=None, help="Publish at HZ (not latched).")
+@click.option("-1", "--once", is_flag=True, help="Publish once, let subscribers get it, exit.")
+@click.option("-l", "--latch", is_flag=True, help="Latch (the default without -r).")
+@click.option("--wait", "wait_time", type=float, default=3.0, show_default=True,
+              help="With -1: longest wait for known subscribers to connect.")
+def topic_pub(name: str, type_name: str, values: tuple[str, ...], rate: float | None,
+              once: bool, latch: bool, wait_time: float) -> None:
+    """Publish a TYPE message built from YAML VALUES on NAME."""
+    name = _global(name)
+    cls = _message_class(type_name)
+    msg = _fill(cls, _parse_yaml(values, type_name), type_name)
+    if rate is not None and rate <= 0:
+        raise OrchestraError("--rate must be positive")
+    rospy = _start_cli_node()
+    try:
+        latched = latch or rate is None
+        pub = rospy.Publisher(name, cls, queue_size=100, latch=latched)
+        if once:
+            expected = len(introspect.system_state(_master_uri()).subscribers.get(name, []))
+            click.echo(f"publishing and latching message for up to {wait_time:g} seconds "
+                       f"({expected} subscriber{'s' if expected != 1 else ''})")
+            pub.publish(msg)
+            deadline = time.monotonic() + wait_time
+            while pub.get_num_connections() < expected and time.monotonic() < deadline:
+                time.sleep(0.01)
+            _drain(pub, deadline)
+        elif rate is None:
+            click.echo("publishing and latching message. Press ctrl-C to terminate")
+            pub.publish(msg)
+            rospy.spin()
+        else:
+            r = rospy.Rate(rate)
+            while True:
+                pub.publish(msg)
+                r.sleep()
+    except (KeyboardInterrupt, rospy.ROSInterruptException):
+        pass
+    finally:
+        _stop_cli_node("topic pub done")
+
+
+def _drain(pub, deadline: float) -> None:
+    """Wait until every connection's queue is written out (or the deadline passes)."""
+    impl = pub._impl
+    while time.monotonic() < deadline:
+        with impl.lock:
+            busy = any(c.queue for c in impl.connections)
+        if not busy:
+            time.sleep(0.05)  # let the kernel hand the last bytes over
+            return
+        time.sleep(0.01)
+
+
+@topic.command("hz")
+@click.argument("name")
+@click.option("-w", "--window", type=click.IntRange(min=2), default=None,
+              help="Use the last N messages only.")
+@click.option("-n", "reports", type=click.IntRange(min=1), default=None,
+              help="Exit after N reports (an orchestra extension).")
+def topic_hz(name: str, window: int | None, reports: int | None) -> None:
+    """Print the publishing rate of NAME every second."""
+    name = _global(name)
+    rospy = _start_cli_node()
+    stamps: list[float] = []
+    done = 0
+    try:
+        _sub, inbox = _subscribe_raw(rospy, name)
+        click.echo(f"subscribed to [{name}]")
+        next_report = time.monotonic() + 1.0
+        last_count = 0
+        while reports is None or done < reports:
+            timeout = max(0.0, next_report - time.monotonic())
+            try:
+                stamp, _ = inbox.get(timeout=timeout)
+                stamps.append(stamp)
+                if window is not None and len(stamps) > window + 1:
+                    del stamps[:-window - 1]
+                continue
+            except queue.Empty:
+                pass
+            next_report += 1.0
+            if len(stamps) < 2 or len(stamps) == last_count and not inbox.qsize():
+                click.echo("no new messages")
+            else:
+                click.echo(hz_report(stamps))
+            last_count = len(stamps)
+            done += 1
+    except KeyboardInterrupt:
+        pass
+    finally:
+        _stop_cli_node("topic hz done")
+
+
+def hz_report(stamps: list[float]) -> str:
+    """rostopic hz's block: average rate, then min/max/std dev of the periods and window."""
+    periods = [b - a for a, b in zip(stamps, stamps[1:])]
+    mean = sum(periods) / len(periods)
+    std = math.sqrt(sum((p - mean) ** 2 for p in periods) / len(periods))
+    rate = 1.0 / mean if mean > 0 else 0.0
+    return (f"average rate: {rate:.3f}\n\tmin: {min(periods):.3f}s max: {max(periods):.3f}s "
+            f"std dev: {std:.5f}s window: {len(stamps)}")
+
+
+# --- service -----------------------------------------------------------------------------------
+
+@click.group()
+def service() -> None:
+    """Services: list, info, type, call (like rosservice)."""
+
+
+@service.command("list")
+def service_list() -> None:
+    """Print every service known to the master."""
+    for name in sorted(introspect.system_state(_master_uri()).services):
+        click.echo(name)
+
+
+@service.command("type")
+@click.argument("name")
+def service_type(name: str) -> None:
+    """Print the service type of NAME (asked from the service itself)."""
+    click.echo(introspect.service_header(_master_uri(), _global(name)).get("type", ""))
+
+
+@service.command("info")
+@click.argument("name")
+def service_info(name: str) -> None:
+    """Node, URI, type and request fields of NAME."""
+    from orchestra.node.msg import MessageNotFound, get_service_class
+    uri_master = _master_uri()
+    name = _global(name)
+    header = introspect.service_header(uri_master, name)
+    state = introspect.system_state(uri_master)
+    providers = state.services.get(name, [])
+    click.echo(f"Node: {providers[0] if providers else 'unknown'}")
+    click.echo(f"URI: {introspect.service_uri(uri_master, name)}")
+    click.echo(f"Type: {header.get('type', 'unknown')}")
+    try:
+        fields = get_service_class(header.get("type", ""))._request_class._fields
+        click.echo(f"Args: {' '.join(fields)}")
+    except (MessageNotFound, ROSException):
+        click.echo("Args: (unknown: no definition of this service type here)")
+
+
+@service.command("call")
+@click.argument("name")
+@click.argument("values", nargs=-1)
+def service_call(name: str, values: tuple[str, ...]) -> None:
+    """Call NAME with a request built from YAML VALUES; print the response as YAML."""
+    from orchestra.node import tcpros
+    from orchestra.node.exceptions import TransportException
+    from orchestra.node.msg import MessageNotFound, get_service_class, to_yaml_text
+    uri_master = _master_uri()
+    name = _global(name)
+    header = introspect.service_header(uri_master, name)
+    srv_type = header.get("type", "")
+    try:
+        cls = get_service_class(srv_type)
+    except (MessageNotFound, ROSException) as exc:
+        raise OrchestraError(f"cannot call {name}: {exc}") from None
+    if header.get("md5sum") not in (None, "*", cls._md5sum):
+        raise OrchestraError(f"service {name} is a different version of {srv_type} "
+                             f"(md5 {header.get('md5sum')}, ours {cls._md5sum})")
+    request = _fill(cls._request_class, _parse_yaml(values, srv_type + " request"),
+                    srv_type + " request")
+    host, port = tcpros.parse_rosrpc_uri(introspect.service_uri(uri_master, name))
+    try:
+        with tcpros.connect(host, port) as sock:
+            tcpros.write_header(sock, {"callerid": introspect.CALLER, "service": name,
+                                       "md5sum": cls._md5sum, "type": srv_type})
+            reply_header = tcpros.read_header(sock)
+            if "error" in reply_header:
+                raise CommandFailed(f"service [{name}] refused the call: {reply_header['error']}")
+            tcpros.send_message(sock, request.serialize_bytes())
+            ok, body = tcpros.read_service_response(sock)
+    except (OSError, TransportException) as exc:
+        raise CommandFailed(f"calling service [{name}] failed: {exc}") from None
+    if not ok:
+        raise CommandFailed(f"service [{name}] responded with an error: "
+                            f"{body.decode('utf-8', 'replace')}")
+    text = to_yaml_text(cls._response_class.deserialize_bytes(body))
+    if text:
+        click.echo(text)
+
+
+# --- graph -------------------------------------------------------------------------------------
+
+@click.command()
+@click.option("-o", "--out", "out", type=click.Path(dir_okay=False), default=None,
+              help="Write to FILE (.svg or .dot); default: DOT on stdout.")
+@click.option("--all", "show_all", is_flag=True, help="Include /rosout.")
+def graph(out: str | None, show_all: bool) -> None:
+    """Draw the running nodes and the topics between them."""
+    from orchestra.node import graph as graphs
+    g = graphs.build_graph(introspect.system_state(_master_uri()), show_all=show_all)
+    if out is None:
+        click.echo(graphs.to_dot(g), nl=False)
+        return
+    lower = out.lower()
+    if lower.endswith(".dot") or lower.endswith(".gv"):
+        text = graphs.to_dot(g)
+    elif lower.endswith(".svg"):
+        text = graphs.to_svg(g)
+    elif lower.endswith(".png"):
+        raise OrchestraError("PNG output is not supported (no rasteriser without a new "
+                             "dependency): use --out graph.svg or graph.dot")
+    else:
+        raise OrchestraError(f"unknown graph format for '{out}': use .svg or .dot")
+    try:
+        with open(out, "w", encoding="utf-8") as fh:
+            fh.write(text)
+    except OSError as exc:
+        raise OrchestraError(f"cannot write {out}: {exc.strerror or exc}") from None
+    click.echo(f"wrote {out} ({g.number_of_nodes()} vertices, {g.number_of_edges()} edges)",
+               err=True)
+

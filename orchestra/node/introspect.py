@@ -1,0 +1,116 @@
+"""Reading the ROS graph from a master (orchestra's or a real one) and from nodes' slave APIs.
+
+Pure data in, pure data out: ``SystemState`` is the master's ``getSystemState`` answer with
+the topic types added; the CLI and the graph drawer only format it.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from orchestra.errors import OrchestraError
+from orchestra.node import tcpros
+from orchestra.node.exceptions import TransportException
+from orchestra.node.masterapi import MasterError, call, raw_call
+
+CALLER = "/orchestra_cli"
+
+
+class GraphError(OrchestraError):
+    """Something asked about the graph does not exist (unknown node, topic or service)."""
+
+
+def master_call(master_uri: str, method: str, *args):
+    """A master call from the CLI: unreachable master -> MasterUnreachable (exit 1)."""
+    from orchestra.master import MasterUnreachable
+
+    try:
+        code, msg, value = raw_call(master_uri, method, CALLER, *args, timeout=5.0)
+    except MasterError as exc:
+        raise MasterUnreachable(f"cannot contact the master at {master_uri}: {exc}") from None
+    if code != 1:
+        raise GraphError(msg)
+    return value
+
+
+@dataclass
+class SystemState:
+    publishers: dict[str, list[str]] = field(default_factory=dict)   # topic -> nodes
+    subscribers: dict[str, list[str]] = field(default_factory=dict)  # topic -> nodes
+    services: dict[str, list[str]] = field(default_factory=dict)     # service -> nodes
+    types: dict[str, str] = field(default_factory=dict)              # topic -> type
+
+    @property
+    def nodes(self) -> list[str]:
+        found: set[str] = set()
+        for table in (self.publishers, self.subscribers, self.services):
+            for names in table.values():
+                found.update(names)
+        return sorted(found)
+
+    @property
+    def topics(self) -> list[str]:
+        return sorted(set(self.publishers) | set(self.subscribers))
+
+    def node_publications(self, node: str) -> list[str]:
+        return sorted(t for t, ns in self.publishers.items() if node in ns)
+
+    def node_subscriptions(self, node: str) -> list[str]:
+        return sorted(t for t, ns in self.subscribers.items() if node in ns)
+
+    def node_services(self, node: str) -> list[str]:
+        return sorted(s for s, ns in self.services.items() if node in ns)
+
+
+def system_state(master_uri: str) -> SystemState:
+    pubs, subs, srvs = master_call(master_uri, "getSystemState")
+    types = dict(master_call(master_uri, "getTopicTypes"))
+    return SystemState({t: list(n) for t, n in pubs}, {t: list(n) for t, n in subs},
+                       {s: list(n) for s, n in srvs}, types)
+
+
+def lookup_node(master_uri: str, node: str) -> str:
+    try:
+        return master_call(master_uri, "lookupNode", node)
+    except GraphError:
+        raise GraphError(f"unknown node [{node}]") from None
+
+
+def node_bus_info(node_uri: str) -> tuple[int | None, list]:
+    """(pid, bus info rows) from a node's slave API; (None, []) when it does not answer."""
+    try:
+        pid = call(node_uri, "getPid", CALLER, timeout=2.0)
+        info = call(node_uri, "getBusInfo", CALLER, timeout=2.0)
+    except MasterError:
+        return None, []
+    return pid, info
+
+
+def kill_node(master_uri: str, node: str) -> None:
+    uri = lookup_node(master_uri, node)
+    try:
+        call(uri, "shutdown", CALLER, "user request", timeout=5.0)
+    except MasterError as exc:
+        raise GraphError(f"node [{node}] did not accept the shutdown request: {exc}") from None
+
+
+def service_uri(master_uri: str, service: str) -> str:
+    try:
+        return master_call(master_uri, "lookupService", service)
+    except GraphError:
+        raise GraphError(f"service [{service}] is not available") from None
+
+
+def service_header(master_uri: str, service: str) -> dict[str, str]:
+    """The service's connection header, obtained with a ``probe`` connection (as rosservice)."""
+    uri = service_uri(master_uri, service)
+    host, port = tcpros.parse_rosrpc_uri(uri)
+    try:
+        with tcpros.connect(host, port, timeout=5.0) as sock:
+            tcpros.write_header(sock, {"callerid": CALLER, "service": service, "md5sum": "*",
+                                       "probe": "1"})
+            header = tcpros.read_header(sock)
+    except (OSError, TransportException) as exc:
+        raise GraphError(f"service [{service}] at {uri} does not answer: {exc}") from None
+    if "error" in header:
+        raise GraphError(f"service [{service}]: {header['error']}")
+    return header
