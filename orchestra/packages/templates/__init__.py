@@ -1,0 +1,1 @@
+"""jinja2 templates for `orchestra create-pkg` (a package so that installs ship the files)."""
