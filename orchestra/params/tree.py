@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from typing import Any, Callable, Iterator
 
 from orchestra.errors import Location, OrchestraError
+from orchestra.names import canonicalize, namespace, ns_join
 
 SEP = "/"
 INT32_MIN = -(2 ** 31)
@@ -31,34 +32,10 @@ class ParamValueError(OrchestraError):
     """A value the parameter server cannot hold (it could not travel over XML-RPC)."""
 
 
-# --- names -----------------------------------------------------------------------------------
+# --- names (the shared graph-name rules, plus the master's caller-relative resolution) ----
 
-def canonical(name: str) -> str:
-    """``/a//b/`` -> ``/a/b``: collapse repeated and trailing separators, keep global-ness."""
-    if not name or name == SEP:
-        return name
-    parts = [p for p in name.split(SEP) if p]
-    if name[0] == SEP:
-        return SEP + SEP.join(parts)
-    return SEP.join(parts)
-
-
-def namespace_of(name: str) -> str:
-    """The namespace a name lives in, with a trailing ``/``: ``/a/b`` -> ``/a/``."""
-    if not name or name == SEP:
-        return SEP
-    if name.endswith(SEP):
-        name = name[:-1]
-    return name[: name.rfind(SEP) + 1] or SEP
-
-
-def ns_join(ns: str, name: str) -> str:
-    """Join a namespace and a relative name; global and private names are left alone."""
-    if name.startswith((SEP, "~")) or not ns:
-        return name
-    if ns.endswith(SEP):
-        return ns + name
-    return ns + SEP + name
+canonical = canonicalize
+namespace_of = namespace
 
 
 def resolve(name: str, caller_id: str) -> str:
