@@ -342,21 +342,33 @@ import os, sys
 from orchestra.supervise.process import ProcessSpec, RestartPolicy
 from orchestra.supervise.reaper import Watchdog
 from orchestra.supervise.supervisor import Supervisor
-tmp = sys.argv[1]
-watchdog = Watchdog()
+tmp, pdeathsig, with_watchdog = sys.argv[1], sys.argv[2], sys.argv[3] == "1"
+watchdog = Watchdog() if with_watchdog else None
 script = "sleep 1000 & echo $! > {0}/gc$N; echo $$ > {0}/n$N; wait".format(tmp)
 specs = [ProcessSpec("/n%d" % i, ("/bin/sh", "-c", script), dict(os.environ, N=str(i)), tmp)
          for i in range(3)]
-Supervisor(specs, RestartPolicy(), watchdog=watchdog).run()
+Supervisor(specs, RestartPolicy(), watchdog=watchdog, pdeathsig=pdeathsig).run()
 """
 
 
-def test_sigkilled_orchestra_leaves_no_orphan(tmp_path):
-    proc = subprocess.Popen([sys.executable, "-c", WATCHED_RUN, str(tmp_path)],
+@pytest.mark.parametrize("pdeathsig, with_watchdog", [
+    ("off", True),        # the watchdog alone kills every node's process group
+    ("setpriv", False),   # the parent-death signal alone kills the nodes themselves
+    ("preexec", False),
+    ("auto", True),       # what orchestra launch uses
+])
+def test_sigkilled_orchestra_leaves_no_orphan(tmp_path, pdeathsig, with_watchdog):
+    if pdeathsig == "setpriv":
+        from orchestra.supervise.reaper import setpriv_prefix
+        if setpriv_prefix() is None:
+            pytest.skip("no setpriv with --pdeathsig on this machine")
+    proc = subprocess.Popen([sys.executable, "-c", WATCHED_RUN, str(tmp_path), pdeathsig,
+                             "1" if with_watchdog else "0"],
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    pids: list[int] = []
     try:
         deadline = time.monotonic() + 20
-        names = [f"{k}{i}" for k in ("gc", "n") for i in range(3)]
+        names = [f"{k}{i}" for k in ("n", "gc") for i in range(3)]
         while not all((tmp_path / n).exists() and (tmp_path / n).read_text().strip()
                       for n in names):
             assert time.monotonic() < deadline, "nodes did not start"
@@ -365,8 +377,24 @@ def test_sigkilled_orchestra_leaves_no_orphan(tmp_path):
         assert all(alive(p) for p in pids)
         proc.kill()
         proc.wait()
-        assert wait_dead(pids) == []
+        must_die = pids if with_watchdog else pids[:3]
+        assert wait_dead(must_die) == []
     finally:
         if proc.poll() is None:
             proc.kill()
             proc.wait()
+        for pid in pids:
+            if alive(pid):
+                os.kill(pid, signal.SIGKILL)
+
+
+def test_script_without_shebang_is_a_spawn_failure_in_every_mode(tmp_path):
+    script = tmp_path / "noshebang"
+    script.write_text("echo hi\n")
+    script.chmod(0o755)
+    for mode in ("setpriv", "preexec"):
+        spec = ProcessSpec("/x", (str(script),), dict(os.environ), str(tmp_path))
+        sup = Supervisor([spec], FAST, screen=quiet_screen(), pdeathsig=mode)
+        run(sup)
+        assert sup.procs[0].state == State.FAILED
+        assert "Exec format error" in sup.procs[0].reason

@@ -24,7 +24,8 @@ from orchestra.supervise.loop import EventLoop, Timer
 from orchestra.supervise.output import NodeOutput, Screen
 from orchestra.supervise.process import (TERMINAL, ManagedProcess, ProcessSpec, RestartPolicy,
                                          State, describe_exit, restart_delay)
-from orchestra.supervise.reaper import Watchdog, child_setup, descendants, signal_group
+from orchestra.supervise.reaper import (Watchdog, check_executable, child_setup, descendants,
+                                        setpriv_prefix, signal_group)
 
 logger = logging.getLogger(__name__)
 
@@ -54,7 +55,8 @@ class Supervisor:
     def __init__(self, specs: Sequence[ProcessSpec], policy: RestartPolicy | None = None,
                  screen: Screen | None = None, log_dir: str | None = None,
                  watchdog: Watchdog | None = None, log_max_bytes: int = 0,
-                 log_backups: int = 5, on_change: Callable[[], None] | None = None):
+                 log_backups: int = 5, on_change: Callable[[], None] | None = None,
+                 pdeathsig: str = "auto"):
         names = [s.name for s in specs]
         if len(set(names)) != len(names):
             raise ValueError("process names must be unique")
@@ -63,6 +65,13 @@ class Supervisor:
         self.log_dir = log_dir
         self.watchdog = watchdog
         self.on_change = on_change
+        if pdeathsig in ("auto", "setpriv") and not setpriv_prefix():
+            pdeathsig = "preexec"          # same guarantee, slower spawn
+        elif pdeathsig == "auto":
+            pdeathsig = "setpriv"
+        if pdeathsig not in ("setpriv", "preexec", "off"):
+            raise ValueError(f"pdeathsig must be auto, setpriv, preexec or off: {pdeathsig!r}")
+        self.pdeathsig = pdeathsig
         self.loop = EventLoop()
         self.procs = [ManagedProcess(spec, start_index=i) for i, spec in enumerate(specs)]
         self.outputs = {
@@ -154,12 +163,19 @@ class Supervisor:
         spec = proc.spec
         if proc.state == State.BACKOFF:
             proc.transition(State.STARTING, "respawn")
+        argv = list(spec.argv)
+        preexec = None
         try:
             os.makedirs(spec.cwd, exist_ok=True)
+            if self.pdeathsig == "setpriv":
+                check_executable(argv[0], spec.env, spec.cwd)
+                argv = [*setpriv_prefix(), *argv]
+            elif self.pdeathsig == "preexec":
+                preexec = child_setup(self._pid)
             popen = subprocess.Popen(
-                list(spec.argv), cwd=spec.cwd, env=dict(spec.env), stdin=subprocess.DEVNULL,
+                argv, cwd=spec.cwd, env=dict(spec.env), stdin=subprocess.DEVNULL,
                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, close_fds=True,
-                start_new_session=True, preexec_fn=child_setup(self._pid))
+                start_new_session=True, preexec_fn=preexec)
         except (OSError, subprocess.SubprocessError) as exc:
             self._spawn_failed(proc, exc)
             return
