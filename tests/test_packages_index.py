@@ -263,3 +263,14 @@ def test_cache_directory_is_pruned_to_the_most_recent_files(tmp_path, monkeypatc
     left = sorted(os.listdir(cache_dir))
     expected = ["/root/new", "/root/4", "/root/3"]
     assert left == sorted(os.path.basename(cache.cache_file(cache_dir, r)) for r in expected)
+
+
+def test_deleted_cwd_does_not_break_lookup(tmp_path, monkeypatch):
+    make_pkg(tmp_path / "rpp" / "still_here")
+    gone = tmp_path / "gone"
+    gone.mkdir()
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(tmp_path / "rpp"))
+    monkeypatch.setenv("ROS_HOME", str(tmp_path / "rh"))
+    monkeypatch.chdir(gone)
+    gone.rmdir()
+    assert find_package("still_here") == str(tmp_path / "rpp" / "still_here")

@@ -98,10 +98,18 @@ def catkin_prefixes(environ: Mapping[str, str], cwd: str) -> list[str]:
     return prefixes
 
 
+def current_directory() -> str:
+    """The cwd, or ``/`` when it was deleted under us (no workspace then, rather than a crash)."""
+    try:
+        return os.getcwd()
+    except OSError:
+        return "/"
+
+
 def search_roots(environ: Mapping[str, str] | None = None, cwd: str | None = None) -> list[SearchRoot]:
     """The directories crawled for packages, in priority order, each listed once."""
     env = os.environ if environ is None else environ
-    here = os.getcwd() if cwd is None else cwd
+    here = current_directory() if cwd is None else cwd
     roots: list[SearchRoot] = []
     seen: set[str] = set()
 

@@ -12,7 +12,7 @@ import os
 from typing import Mapping
 
 from orchestra.errors import OrchestraError
-from orchestra.packages.discovery import catkin_prefixes
+from orchestra.packages.discovery import catkin_prefixes, current_directory
 from orchestra.packages.index import find_package
 
 
@@ -37,7 +37,7 @@ def libexec_dirs(package: str, environ: Mapping[str, str] | None = None,
                  cwd: str | None = None) -> list[str]:
     """``lib/<pkg>`` and ``share/<pkg>`` of the first catkin prefix that has either."""
     env = os.environ if environ is None else environ
-    here = os.getcwd() if cwd is None else cwd
+    here = current_directory() if cwd is None else cwd
     for prefix in catkin_prefixes(env, here):
         found = [d for d in (os.path.join(prefix, "lib", package),
                              os.path.join(prefix, "share", package)) if os.path.isdir(d)]

@@ -17,7 +17,8 @@ from dataclasses import dataclass, field
 from orchestra.errors import OrchestraError
 from orchestra.packages import cache
 from orchestra.packages.crawl import crawl
-from orchestra.packages.discovery import BUNDLED_PACKAGES, SearchRoot, search_path, search_roots
+from orchestra.packages.discovery import (BUNDLED_PACKAGES, SearchRoot, current_directory,
+                                          search_path, search_roots)
 
 log = logging.getLogger(__name__)
 
@@ -91,11 +92,8 @@ _INDEX: tuple[tuple, PackageIndex] | None = None
 
 def _key() -> tuple:
     env = os.environ
-    try:
-        cwd = os.getcwd()
-    except OSError:  # the cwd was deleted under us
-        cwd = "/"
-    return (env.get("ROS_PACKAGE_PATH"), env.get("CMAKE_PREFIX_PATH"), env.get("ROS_HOME"), cwd)
+    return (env.get("ROS_PACKAGE_PATH"), env.get("CMAKE_PREFIX_PATH"), env.get("ROS_HOME"),
+            current_directory())
 
 
 def get_index(refresh: bool = False) -> PackageIndex:
