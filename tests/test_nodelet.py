@@ -177,3 +177,68 @@ def test_shutdown_stops_timers_and_is_idempotent():
     count = len(ticks)
     threading.Event().wait(0.05)
     assert len(ticks) <= count + 1
+
+
+# ---- in-process bus --------------------------------------------------------------------
+class FakeMsg:
+    def __init__(self, value, type_="std_msgs/String"):
+        self.value, self._type = value, type_
+
+
+def collect(bus, topic, type_="std_msgs/String", queue_size=10):
+    import threading
+    got, event = [], threading.Event()
+
+    def cb(msg):
+        got.append(msg.value)
+        event.set()
+    return bus.subscribe(topic, type_, cb, queue_size), got, event
+
+
+def test_local_bus_delivers_to_same_topic_and_type_only():
+    from nodelet.local import LocalBus
+    bus = LocalBus()
+    _, got, event = collect(bus, "/a")
+    _, other, _ = collect(bus, "/b")
+    assert bus.publish("/a", FakeMsg(1)) == 1
+    assert bus.publish("/a", FakeMsg(2, "geometry_msgs/Twist")) == 0
+    assert event.wait(2.0)
+    assert got == [1] and other == []
+
+
+def test_local_bus_gives_latched_message_to_late_subscriber():
+    from nodelet.local import LocalBus
+    bus = LocalBus()
+    bus.publish("/active", FakeMsg("idle"), latch=True)
+    _, got, event = collect(bus, "/active")
+    assert event.wait(2.0) and got == ["idle"]
+
+
+def test_local_bus_unregister_stops_delivery():
+    from nodelet.local import LocalBus
+    bus = LocalBus()
+    sub, got, _ = collect(bus, "/a")
+    sub.unregister()
+    assert bus.publish("/a", FakeMsg(1)) == 0 and bus.count("/a") == 0
+
+
+def test_slow_local_subscriber_does_not_block_publisher_and_drops_oldest():
+    import threading
+    import time
+    from nodelet.local import LocalBus
+    bus = LocalBus()
+    release, got = threading.Event(), []
+
+    def slow(msg):
+        release.wait(5.0)
+        got.append(msg.value)
+    bus.subscribe("/a", "std_msgs/String", slow, queue_size=2)
+    start = time.monotonic()
+    for i in range(10):
+        bus.publish("/a", FakeMsg(i))
+    assert time.monotonic() - start < 1.0
+    release.set()
+    deadline = time.monotonic() + 2.0
+    while len(got) < 3 and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert got[-1] == 9 and len(got) <= 3
