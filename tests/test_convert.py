@@ -17,6 +17,7 @@ from orchestra.launch.entity import Entity
 
 WS = COMPAT / "ws"
 SMOKE = json.loads((COMPAT / "smoke.json").read_text()) if COMPAT.is_dir() else []
+CASES = json.loads((COMPAT / "cases.json").read_text()) if COMPAT.is_dir() else []
 
 
 def shape(entity: Entity):
@@ -61,6 +62,79 @@ def test_converted_yaml_keeps_line_numbers_meaningful():
     lines = yaml_text.splitlines()
     for child in root.children:
         assert lines[child.location.line - 1].strip().startswith(f"- {child.tag}:")
+
+
+# ------------------------------------------- converted trees resolve to the same plans
+
+@pytest.fixture(scope="module")
+def yaml_ws(tmp_path_factory):
+    """A copy of the compat workspace with every launch file converted to YAML beside it
+    (``orchestra convert DIR --to yaml``: includes of converted files point at the YAML)."""
+    root = tmp_path_factory.mktemp("yaml_ws") / "ws"
+    shutil.copytree(WS, root, symlinks=True)
+    for dirpath, _, _ in os.walk(root):
+        os.chmod(dirpath, 0o755)  # the corpus is read-only; the copy must take new files
+    proc = run_cli("convert", str(root), "--to", "yaml")
+    assert proc.returncode == 0, proc.stderr
+    converted = {}
+    for line in proc.stdout.splitlines():
+        source, _, target = line.partition(" -> ")
+        converted[target] = source
+    return root, converted
+
+
+@pytest.fixture
+def compat_env(monkeypatch, yaml_ws):
+    """The corpus's environment convention: only PATH, ROS_PACKAGE_PATH and ROS_DISTRO."""
+    for name in list(os.environ):
+        if name not in ("PATH",):
+            monkeypatch.delenv(name)
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(yaml_ws[0]))
+    monkeypatch.setenv("ROS_DISTRO", "noetic")
+    return monkeypatch
+
+
+def resolved(path: str, words: list[str], converted: dict[str, str]) -> str:
+    """The plan (or the error) of ``path`` as JSON text, converted file names mapped back to
+    their sources so that an XML tree and its YAML conversion can be compared."""
+    from orchestra.launch.interpreter import binary_to_json, load_launch
+    from orchestra.names import load_mappings
+
+    try:
+        plan = load_launch(path, load_mappings(words), no_exec=True)
+        text = json.dumps(plan.to_json(), default=binary_to_json, sort_keys=True)
+    except OrchestraError as exc:
+        text = "error: " + exc.message
+    for target in sorted(converted, key=len, reverse=True):
+        text = text.replace(target, converted[target])
+    return text
+
+
+@pytest.mark.parametrize("case", CASES, ids=[c["id"] for c in CASES])
+def test_compat_case_converted_to_yaml_resolves_to_the_same_plan(case, yaml_ws, compat_env):
+    root, converted = yaml_ws
+    for name, value in case["env"].items():
+        compat_env.setenv(name, value)
+    words = [f"{k}:={v}" for k, v in case["args"].items()]
+    source = str(root / case["launch_file"])
+    target = convert.target_name(source, "yaml")
+    assert target in converted  # the top file and (below) its includes were converted
+    from_xml = resolved(source, words, converted)
+    from_yaml = resolved(target, words, converted)
+    assert not from_xml.startswith("error"), from_xml
+    assert from_yaml == from_xml
+    loaded = json.loads(resolved(target, words, {}))["files_loaded"]
+    assert loaded[0] == target
+
+
+@pytest.mark.parametrize("launch_file", [item["launch_file"] for item in SMOKE])
+def test_smoke_file_converted_to_yaml_resolves_or_fails_the_same(launch_file, yaml_ws,
+                                                                 compat_env):
+    root, converted = yaml_ws
+    source = str(root / launch_file)
+    target = convert.target_name(source, "yaml")
+    assert target in converted
+    assert resolved(target, [], converted) == resolved(source, [], converted)
 
 
 # ---------------------------------------------------------------------- awkward strings
@@ -179,6 +253,7 @@ def test_directory_conversion_writes_nothing_when_one_file_is_bad(tmp_path):
 
 def test_target_names_pair_up():
     assert convert.target_name("d/x.launch", "yaml") == "d/x.launch.yaml"
-    assert convert.target_name("d/x.launch.xml", "yaml") == "d/x.launch.yaml"
+    assert convert.target_name("d/x.launch.xml", "yaml") == "d/x.launch.xml.yaml"
+    assert convert.target_name("d/x.launch.xml.yaml", "xml") == "d/x.launch.xml"
     assert convert.target_name("d/x.launch.yaml", "xml") == "d/x.launch"
     assert convert.target_name("d/x.yml", "xml") == "d/x.launch"

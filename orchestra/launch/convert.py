@@ -182,18 +182,20 @@ def to_xml(entity: Entity) -> str:
 
 
 def target_name(path: str, fmt: str) -> str:
-    """Where the converted ``path`` goes: ``x.launch`` <-> ``x.launch.yaml``."""
+    """Where the converted ``path`` goes: the source name plus ``.yaml`` (``x.launch`` ->
+    ``x.launch.yaml``, ``x.launch.xml`` -> ``x.launch.xml.yaml``), and back by dropping it.
+
+    Appending rather than replacing keeps names unique (packages do ship ``device.launch``
+    beside ``device.launch.xml``) and the way back obvious. A YAML name with no XML launch
+    extension left (``x.yaml``) becomes ``x.launch``.
+    """
     directory, name = os.path.split(path)
-    lower = name.lower()
     if fmt == "yaml":
-        if lower.endswith(".launch.xml"):
-            name = name[: -len(".xml")]
         return os.path.join(directory, name + ".yaml")
-    for suffix in (".launch.yaml", ".launch.yml"):
-        if lower.endswith(suffix):
-            return os.path.join(directory, name[: -len(suffix)] + ".launch")
     stem, _ = os.path.splitext(name)
-    return os.path.join(directory, stem + ".launch")
+    if not stem.lower().endswith((".launch", ".xml")):
+        stem += ".launch"
+    return os.path.join(directory, stem)
 
 
 def convert_file(path: str, fmt: str) -> str:
@@ -212,18 +214,22 @@ class Converted:
 def is_launch_file(path: str, fmt_from: str) -> bool:
     """Whether ``path`` looks like a launch file of format ``fmt_from`` (cheap sniff, no parse).
 
-    XML: ``*.launch`` or an ``*.xml`` whose root element is ``<launch>`` (package.xml and URDF
-    files are not). YAML: a ``*.yaml``/``*.yml`` file whose first key is ``launch:``
-    (rosparam files are not).
+    XML: ``*.launch`` and ``*.test`` (rostest) files, and any other file whose root element
+    is ``<launch>`` (``*.xml``, ``*.machine``...; package.xml and URDFs are not). YAML: a
+    ``*.yaml``/``*.yml`` file whose first key is ``launch:`` (rosparam files are not).
     """
     lower = path.lower()
     if fmt_from == "xml":
-        if lower.endswith(".launch"):
+        if lower.endswith((".launch", ".test")):
             return True
-        if not lower.endswith(".xml"):
+        if yaml_frontend.is_yaml_launch_file(path):
             return False
         try:
-            for _, element in etree.iterparse(path, events=("start",), recover=True):
+            with open(path, "rb") as fh:
+                if not fh.read(512).lstrip().startswith(b"<"):
+                    return False
+            for _, element in etree.iterparse(path, events=("start",), recover=True,
+                                              resolve_entities=False, no_network=True):
                 return element.tag == "launch"
         except (etree.XMLSyntaxError, OSError):
             return False

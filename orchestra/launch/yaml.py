@@ -83,9 +83,10 @@ def _location(filename: str, node: Node) -> Location:
 
 def parse_file(path: str) -> Entity:
     """Read a YAML launch file into its root Entity (normally ``launch``)."""
+    from orchestra.launch.files import read_text  # symlink stubs, as the XML front end
+
     try:
-        with open(path, "r", encoding="utf-8") as fh:
-            text = fh.read()
+        text = read_text(path)
     except FileNotFoundError:
         raise LaunchYamlError("launch file not found", Location(path)) from None
     except (OSError, UnicodeDecodeError) as exc:
