@@ -274,3 +274,30 @@ def test_deleted_cwd_does_not_break_lookup(tmp_path, monkeypatch):
     monkeypatch.chdir(gone)
     gone.rmdir()
     assert find_package("still_here") == str(tmp_path / "rpp" / "still_here")
+
+
+_WRITER = """
+import sys
+from orchestra.packages import cache
+cache_dir, root, n = sys.argv[1], sys.argv[2], int(sys.argv[3])
+records = {f"/r/{i}": [i, "dir", [f"c{j}" for j in range(50)]] for i in range(n)}
+for _ in range(15):
+    assert cache.save(cache_dir, root, records)
+    loaded = cache.load(cache_dir, root)
+    assert len(loaded) in (300, 400), len(loaded)  # a whole file of one writer or the other
+"""
+
+
+@pytest.mark.timeout(120)
+def test_concurrent_writers_and_readers_never_see_a_partial_cache_file(tmp_path):
+    import subprocess
+    import sys
+
+    cache_dir = str(tmp_path / "cache")
+    procs = [subprocess.Popen([sys.executable, "-c", _WRITER, cache_dir, "/shared/root", str(n)],
+                              stderr=subprocess.PIPE, text=True)
+             for n in (300, 400, 300, 400)]
+    for proc in procs:
+        _, err = proc.communicate(timeout=100)
+        assert proc.returncode == 0, err
+    assert [n for n in os.listdir(cache_dir) if n.endswith(".tmp")] == []
