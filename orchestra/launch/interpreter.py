@@ -35,18 +35,19 @@ ROSLAUNCH_VERSION = "1.16.0"
 DEFAULT_TIMEOUT = 10.0
 TEST_TIME_LIMIT = 60.0
 
-NODE_ATTRS = {"pkg", "type", "machine", "name", "args", "output", "respawn", "respawn_delay",
+IF_UNLESS = frozenset({"if", "unless"})
+NODE_ATTRS = IF_UNLESS | {"pkg", "type", "machine", "name", "args", "output", "respawn", "respawn_delay",
               "cwd", "ns", "clear_params", "launch-prefix", "required"}
 TEST_ATTRS = NODE_ATTRS | {"test-name", "time-limit", "retry"}
-MACHINE_ATTRS = {"name", "address", "env-loader", "ssh-port", "user", "password", "default",
+MACHINE_ATTRS = IF_UNLESS | {"name", "address", "env-loader", "ssh-port", "user", "password", "default",
                  "timeout"}
-PARAM_ATTRS = {"name", "value", "type", "textfile", "binfile", "command"}
-ROSPARAM_ATTRS = {"command", "ns", "file", "param", "subst_value"}
-ARG_ATTRS = {"name", "value", "default", "doc"}
-INCLUDE_ATTRS = {"file", "ns", "clear_params", "pass_all_args"}
-GROUP_ATTRS = {"ns", "clear_params"}
-REMAP_ATTRS = {"from", "to"}
-ENV_ATTRS = {"name", "value"}
+PARAM_ATTRS = IF_UNLESS | {"name", "value", "type", "textfile", "binfile", "command"}
+ROSPARAM_ATTRS = IF_UNLESS | {"command", "ns", "file", "param", "subst_value"}
+ARG_ATTRS = IF_UNLESS | {"name", "value", "default", "doc"}
+INCLUDE_ATTRS = IF_UNLESS | {"file", "ns", "clear_params", "pass_all_args"}
+GROUP_ATTRS = IF_UNLESS | {"ns", "clear_params"}
+REMAP_ATTRS = IF_UNLESS | {"from", "to"}
+ENV_ATTRS = IF_UNLESS | {"name", "value"}
 
 
 class LaunchError(OrchestraError):
@@ -153,7 +154,14 @@ class Interpreter:
             raise self._error(entity, exc.message, attr) from None
 
     def _opt(self, entity: Entity, scope: Scope, *attrs: str) -> list[str | None]:
-        return [self._resolve(entity, a, scope) for a in attrs]
+        get = entity.attributes.get
+        out: list[str | None] = []
+        for a in attrs:
+            value = get(a)
+            # fast path: most attribute values hold no substitution at all
+            out.append(value if value is None or "$" not in value
+                       else self._resolve(entity, a, scope))
+        return out
 
     def _req(self, entity: Entity, scope: Scope, *attrs: str) -> list[str]:
         for a in attrs:
@@ -161,9 +169,11 @@ class Interpreter:
                 raise self._error(entity, f"missing required attribute '{a}'")
         return [self._resolve(entity, a, scope) or "" for a in attrs]
 
-    def _check_attrs(self, entity: Entity, allowed: set[str]) -> None:
+    def _check_attrs(self, entity: Entity, allowed: frozenset[str]) -> None:
+        if entity.attributes.keys() <= allowed:
+            return
         for attr in entity.attributes:
-            if attr not in allowed and attr not in ("if", "unless"):
+            if attr not in allowed:
                 self._warn(entity, f"unknown <{entity.tag}> attribute '{attr}'")
 
     def _enabled(self, entity: Entity, scope: Scope) -> bool:

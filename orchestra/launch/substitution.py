@@ -16,6 +16,7 @@ from __future__ import annotations
 import ast
 import builtins
 import os
+import re
 from typing import Any, Callable, Mapping, Protocol
 
 from orchestra.errors import OrchestraError
@@ -50,8 +51,21 @@ def _find_package(name: str) -> str:
     return find_package(name)
 
 
+_SIMPLE_GROUP = re.compile(r"\$\(([^$()]+)\)")
+
+
 def collect(text: str) -> list[str]:
     """The bodies of the ``$(...)`` groups in ``text``, in order (roslaunch's scanner)."""
+    if "$(" not in text:
+        return []
+    # fast path for the usual text; anything unusual goes through the exact scanner below
+    simple = _SIMPLE_GROUP.findall(text)
+    if "$(" not in _SIMPLE_GROUP.sub("", text):
+        return simple
+    return _scan(text)
+
+
+def _scan(text: str) -> list[str]:
     found: list[str] = []
     buf: list[str] = []
     state = 0  # 0 outside, 1 after '$', 2 after '$(', 3 inside

@@ -37,20 +37,22 @@ def _qualified(element: etree._Element, name: str) -> str:
     return f"{prefix}:{qname.localname}" if prefix else qname.localname
 
 
-def _text_of(element: etree._Element) -> str | None:
-    pieces = [element.text or ""]
-    for child in element:
-        pieces.append(child.tail or "")
-    text = "".join(pieces)
-    return text if text else None
-
-
 def _wrap(element: etree._Element, filename: str) -> Entity:
-    children = [_wrap(child, filename) for child in element
-                if isinstance(child.tag, str)]
-    attributes = {_qualified(element, k): v for k, v in element.attrib.items()}
-    return Entity(tag=_qualified(element, element.tag), attributes=attributes,
-                  children=children, text=_text_of(element),
+    children = []
+    pieces = [element.text] if element.text else []
+    for child in element:
+        if isinstance(child.tag, str):
+            children.append(_wrap(child, filename))
+        if child.tail:
+            pieces.append(child.tail)
+    attributes = dict(element.attrib)
+    if any(k[0] == "{" for k in attributes):
+        attributes = {_qualified(element, k): v for k, v in attributes.items()}
+    tag = element.tag
+    if tag[0] == "{":
+        tag = _qualified(element, tag)
+    return Entity(tag=tag, attributes=attributes, children=children,
+                  text="".join(pieces) or None,
                   location=Location(filename, element.sourceline))
 
 
