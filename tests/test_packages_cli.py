@@ -187,3 +187,13 @@ def test_run_unknown_executable_is_one_line_error(env, tmp_path):
     assert proc.returncode == 2
     assert "cannot find executable 'nope' in package 'runner'" in proc.stderr
     assert "Traceback" not in proc.stderr
+
+
+def test_pkg_show_prints_manifest_metadata_and_dependencies(env, tmp_path):
+    package(env, "shown", ["roscpp"])
+    proc = cli("pkg", "show", "shown", cwd=tmp_path)
+    assert proc.returncode == 0
+    lines = proc.stdout.splitlines()
+    assert "name: shown" in lines and "version: 1.0.0" in lines
+    assert "build_depends: roscpp" in lines and "exec_depends: roscpp" in lines
+    assert "no <maintainer>" in proc.stderr

@@ -46,6 +46,38 @@ def find_cmd(name: str) -> None:
     click.echo(find_package(name))
 
 
+@pkg.command("show")
+@click.argument("name")
+def show_cmd(name: str) -> None:
+    """What package NAME's manifest says: metadata, dependencies by kind, exports."""
+    from orchestra.packages.index import find_package
+    from orchestra.packages.manifest import parse_manifest
+
+    manifest = parse_manifest(find_package(name))
+    people = lambda persons: ", ".join(  # noqa: E731
+        f"{p.name} <{p.email}>" if p.email else p.name for p in persons)
+    click.echo(f"name: {manifest.name}")
+    click.echo(f"path: {os.path.dirname(manifest.path)}")
+    click.echo(f"format: {manifest.format or 'rosbuild manifest.xml'}")
+    click.echo(f"version: {manifest.version or ''}")
+    click.echo(f"description: {manifest.description}")
+    click.echo(f"maintainers: {people(manifest.maintainers)}")
+    if manifest.authors:
+        click.echo(f"authors: {people(manifest.authors)}")
+    click.echo(f"licenses: {', '.join(manifest.licenses)}")
+    for kind, names in manifest.dependencies_by_kind().items():
+        if names:
+            click.echo(f"{kind}_depends: {' '.join(names)}")
+    for tag in ("conflict", "replace", "group_depend", "member_of_group"):
+        if manifest.relation(tag):
+            click.echo(f"{tag}: {' '.join(manifest.relation(tag))}")
+    for export in manifest.exports:
+        attrs = " ".join(f'{k}="{v}"' for k, v in export.attributes)
+        click.echo(f"export: <{export.tag}{' ' + attrs if attrs else ''}>{export.content}")
+    for warning in manifest.warnings:
+        click.echo(f"orchestra: warning: {manifest.path}: {warning}", err=True)
+
+
 @pkg.command("roots")
 def roots_cmd() -> None:
     """The directories searched for packages, highest priority first."""
