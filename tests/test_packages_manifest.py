@@ -177,3 +177,13 @@ def test_dependency_cycle_is_an_error_naming_the_cycle(tmp_path):
     index = PackageIndex.build([str(tmp_path)], cache_dir=None)
     with pytest.raises(Exception, match="dependency cycle: (a -> b -> a|b -> a -> b)"):
         build_graph(["a"], index=index).transitive("a")
+
+
+def test_conditions_default_to_a_ros1_noetic_environment(tmp_path, monkeypatch):
+    for var in ("ROS_VERSION", "ROS_PYTHON_VERSION", "ROS_DISTRO"):
+        monkeypatch.delenv(var, raising=False)
+    m = parse_manifest(write(tmp_path, FORMAT3))
+    assert m.depends(("buildtool",)) == ["catkin"]
+    assert m.depends(("exec",)) == ["roscpp", "python3-yaml"]
+    monkeypatch.setenv("ROS_VERSION", "2")
+    assert m.depends(("buildtool",)) == ["ament_cmake"]

@@ -45,6 +45,10 @@ _RELATION_TAGS = ("conflict", "replace", "group_depend", "member_of_group")
 _VERSION_ATTRS = ("version_lt", "version_lte", "version_eq", "version_gte", "version_gt")
 _VERSION = re.compile(r"^\d+\.\d+\.\d+$")
 
+#: what a sourced ROS 1 (noetic) environment defines; conditions see these unless the
+#: environment says otherwise, so `$ROS_VERSION == 1` holds without ROS installed
+CONDITION_DEFAULTS = {"ROS_VERSION": "1", "ROS_PYTHON_VERSION": "3", "ROS_DISTRO": "noetic"}
+
 _PARSER = etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False,
                           huge_tree=False, remove_comments=True, remove_pis=True)
 
@@ -99,7 +103,12 @@ class Manifest:
 
     def depends(self, kinds: tuple[str, ...] | None = None,
                 environ: Mapping[str, str] | None = None) -> list[str]:
-        """Names this package depends on with any of ``kinds`` (default all), conditions applied."""
+        """Names this package depends on with any of ``kinds`` (default all), conditions applied.
+
+        ``environ`` defaults to the process environment over ``CONDITION_DEFAULTS``.
+        """
+        if environ is None:
+            environ = {**CONDITION_DEFAULTS, **os.environ}
         wanted = set(KINDS if kinds is None else kinds)
         table = _FORMAT1_TAGS if self.format == 1 else _FORMAT2_TAGS
         names: list[str] = []
