@@ -6,6 +6,7 @@ rospy talks to it, and uses small XML-RPC "slave" servers to receive the master'
 from __future__ import annotations
 
 import os
+import socket
 import threading
 import time
 import xmlrpc.client
@@ -177,12 +178,24 @@ def test_publisher_updates_arrive_in_order_per_node(m, slaves):
     assert [len(c[3]) for c in calls] == [1, 2, 3, 4, 5, 4, 3, 2, 1, 0]
 
 
-def test_slow_subscriber_does_not_block_registration(m, slaves):
-    # a subscriber URI where nothing answers: the register call still returns at once
-    m.registerSubscriber("/dead", "/t", "std_msgs/Int32", "http://127.0.0.1:9/")
-    start = time.monotonic()
-    m.registerPublisher("/p", "/t", "std_msgs/Int32", slaves().uri)
-    assert time.monotonic() - start < 2.0
+def test_hung_subscriber_blocks_neither_registration_nor_other_nodes(m, slaves):
+    # a slave that accepts connections but never answers
+    hung = socket.socket()
+    hung.bind(("127.0.0.1", 0))
+    hung.listen(8)
+    try:
+        m.registerSubscriber("/hung", "/t", "std_msgs/Int32",
+                             f"http://127.0.0.1:{hung.getsockname()[1]}/")
+        healthy = slaves()
+        m.registerSubscriber("/ok", "/t", "std_msgs/Int32", healthy.uri)
+        start = time.monotonic()
+        pub = slaves()
+        m.registerPublisher("/p", "/t", "std_msgs/Int32", pub.uri)
+        assert time.monotonic() - start < 2.0
+        assert healthy.wait_for(1, timeout=5) == [
+            ("publisherUpdate", "/master", "/t", [pub.uri])]
+    finally:
+        hung.close()
 
 
 def test_lookup_node_returns_slave_api_and_unknown_node_is_error(m, slaves):

@@ -185,3 +185,15 @@ def test_unreachable_master_is_an_error_not_a_traceback(run, monkeypatch):
     monkeypatch.setenv("ROS_MASTER_URI", handle.uri)
     code, _, err = run("list")
     assert code == 1 and "unable to communicate with master" in err
+
+
+def test_load_from_stdin(master, run, monkeypatch):
+    import io
+    monkeypatch.setattr("sys.stdin", io.StringIO("a: {b: 1}\n"))
+    assert run("load", "-", "/in")[0] == 0
+    assert master.params.get("/in/a/b") == 1
+
+
+def test_get_binary_prints_yaml_binary_tag(master, run):
+    master.params.set("/blob", xmlrpc.client.Binary(b"abc"))
+    assert run("get", "/blob")[1] == "!!binary |-\n  YWJj\n\n"

@@ -164,7 +164,7 @@ def set_cmd(master: _Master, name: str, value: str | None, textfile: str | None,
 @click.argument("name")
 @click.pass_obj
 def delete_cmd(master: _Master, name: str) -> None:
-    """Delete a parameter or a whole namespace (``/`` empties the server)."""
+    """Delete a parameter or a whole namespace ('/' empties the server)."""
     target = _cli_name(name)
     if target == SEP:
         master.call("setParam", SEP, {})
@@ -177,7 +177,7 @@ def delete_cmd(master: _Master, name: str) -> None:
 @click.argument("namespace", required=False)
 @click.pass_obj
 def load_cmd(master: _Master, file: str, namespace: str | None) -> None:
-    """Load a YAML file (``-`` = stdin) into NAMESPACE; every document, ``_ns`` honoured."""
+    """Load a YAML file ('-' = stdin) into NAMESPACE; every document, _ns honoured."""
     if file == "-":
         text, filename = sys.stdin.read(), "<stdin>"
     else:
@@ -227,7 +227,7 @@ def load_documents(text: str, filename: str, default_ns: str) -> list[tuple[str,
 @click.argument("namespace", required=False)
 @click.pass_obj
 def dump_cmd(master: _Master, file: str | None, namespace: str | None) -> None:
-    """Write NAMESPACE (default: all) as YAML to FILE (default or ``-``: stdout)."""
+    """Write NAMESPACE (default: all) as YAML to FILE (default or '-': stdout)."""
     value = master.call("getParam", _cli_name(namespace))
     text = dump_yaml(value)
     if not file or file == "-":
