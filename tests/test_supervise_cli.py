@@ -155,3 +155,53 @@ def test_log_files_named_like_roslaunch_with_latest_link(launch_env):
     names = sorted(p.name for p in latest.iterdir())
     # output="log" nodes get files; the output="screen" node /g/b does not
     assert names == ["a-1-stderr.log", "a-1-stdout.log", "c-3-stderr.log", "c-3-stdout.log"]
+
+
+def test_wait_flag_waits_for_an_external_master_and_uses_it(launch_env):
+    import xmlrpc.client
+
+    from orchestra.master import port_from_uri, start_master
+
+    proc = start(launch_env, "--wait")
+    master = None
+    try:
+        deadline = time.monotonic() + 20
+        while b"waiting for the master" not in _peek_stderr(proc):
+            assert proc.poll() is None and time.monotonic() < deadline
+            time.sleep(0.05)
+        assert list(launch_env["pids"].iterdir()) == []      # nothing started meanwhile
+        master = start_master("127.0.0.1", port_from_uri(launch_env["env"]["ROS_MASTER_URI"]))
+        pids = wait_pids(launch_env, proc)
+        code, _, run_id = xmlrpc.client.ServerProxy(master.uri).getParam("/t", "/run_id")
+        assert code == 1 and run_id
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=30)
+        assert proc.returncode == 0, err
+        assert "started embedded master" not in err
+        assert survivors(pids, limit=1) == []
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+        if master is not None:
+            master.shutdown()
+
+
+_STDERR: dict[int, bytes] = {}
+
+
+def _peek_stderr(proc) -> bytes:
+    """What the process wrote to stderr so far (non-blocking; kept for communicate())."""
+    import fcntl
+
+    fd = proc.stderr.fileno()
+    flags = fcntl.fcntl(fd, fcntl.F_GETFL)
+    fcntl.fcntl(fd, fcntl.F_SETFL, flags | os.O_NONBLOCK)
+    try:
+        chunk = os.read(fd, 65536)
+    except BlockingIOError:
+        chunk = b""
+    finally:
+        fcntl.fcntl(fd, fcntl.F_SETFL, flags)
+    _STDERR[proc.pid] = _STDERR.get(proc.pid, b"") + chunk
+    return _STDERR[proc.pid]

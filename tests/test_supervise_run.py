@@ -112,10 +112,60 @@ def test_required_node_death_exits_nonzero_naming_the_node(run_env, monkeypatch,
 
 def test_all_required_flag_makes_any_death_fatal(run_env, monkeypatch, capsys):
     monkeypatch.setenv("PROBE_MODE_idle", "sleep")
-    monkeypatch.setenv("PROBE_MODE_quitter", "exit0")
+    monkeypatch.setenv("PROBE_MODE_quitter", "exit3")
     plan = LaunchPlan(nodes=(Node("demo", "probe", "idle"), Node("demo", "probe", "quitter")))
     assert run_plan(plan, dict(OPTS, all_required=True)) == 1
     assert "/quitter" in capsys.readouterr().err
+
+
+def test_required_node_finishing_cleanly_ends_the_launch_with_zero(run_env, monkeypatch,
+                                                                  capsys):
+    monkeypatch.setenv("PROBE_MODE_idle", "sleep")
+    monkeypatch.setenv("PROBE_MODE_job", "exit0")
+    plan = LaunchPlan(nodes=(Node("demo", "probe", "idle"),
+                             Node("demo", "probe", "job", required=True)))
+    assert run_plan(plan, OPTS) == 0
+    assert "required process [/job] has finished" in capsys.readouterr().err
+
+
+def test_required_node_whose_launch_prefix_cannot_start_exits_nonzero(run_env, monkeypatch,
+                                                                      capsys):
+    monkeypatch.setenv("PROBE_MODE_idle", "sleep")
+    plan = LaunchPlan(nodes=(
+        Node("demo", "probe", "idle"),
+        Node("demo", "probe", "vital", required=True, launch_prefix="no-such-debugger -x",
+             filename="/x/v.launch", line=2)))
+    assert run_plan(plan, OPTS) == 1
+    err = capsys.readouterr().err
+    assert "/x/v.launch:2: cannot start /vital" in err
+    assert "required process /vital failed to start" in err
+
+
+def test_node_timeout_option_overrides_stop_timeouts_per_node(run_env):
+    from orchestra.supervise.runner import RunOptions, build_specs
+
+    nodes = [Node("demo", "probe", "slow"), Node("demo", "probe", "fast")]
+    exes = {n.full_name: run_env["probe"] for n in nodes}
+    opts = RunOptions.from_kwargs({"sigint_timeout": 3.0, "node_timeouts": ("/slow=30,5",)})
+    slow, fast = build_specs(nodes, exes, "http://m:1/", str(run_env["tmp"]), opts)
+    assert (slow.sigint_timeout, slow.sigterm_timeout) == (30.0, 5.0)
+    assert (fast.sigint_timeout, fast.sigterm_timeout) == (3.0, 2.0)
+
+
+@pytest.mark.parametrize("output, flags, expected", [
+    (None, {}, OutputMode.LOG), ("screen", {}, OutputMode.SCREEN),
+    ("both", {}, OutputMode.BOTH), ("log", {"force_screen": True}, OutputMode.SCREEN),
+    ("screen", {"force_log": True}, OutputMode.LOG),
+])
+def test_output_mode_from_node_and_screen_log_overrides(output, flags, expected):
+    from orchestra.supervise.runner import RunOptions, output_mode
+
+    assert output_mode(Node("p", "t", "n", output=output), RunOptions(**flags)) == expected
+
+
+def test_screen_and_log_together_is_a_user_error():
+    with pytest.raises(OrchestraError):
+        run_plan(LaunchPlan(), {"force_screen": True, "force_log": True})
 
 
 def test_missing_executable_fails_before_anything_starts(run_env):

@@ -4,8 +4,9 @@ Takes plain ProcessSpecs (no launch plan, no master), so it is tested and benchm
 own. One event loop (``loop.py``) watches, per child, a pidfd (exit) and two pipes (output);
 plus the signal wake-up pipe and the status socket. Nothing polls.
 
-Exit code of a run: 0 when stopped on request or when every node ended by itself; 1 when a
-required node died or failed to start, or when any node ended FAILED (the message says which).
+Exit code of a run: 0 when stopped on request, when every node ended by itself, or when a
+required node finished with exit code 0; 1 when a required node died (signal or non-zero
+exit) or failed to start, or when any node ended FAILED (the message says which).
 """
 from __future__ import annotations
 
@@ -253,6 +254,14 @@ class Supervisor:
             return
         described = describe_exit(code)
         if spec.required:
+            # a required node that finishes cleanly ends the launch successfully (the
+            # "run this job, then stop everything" pattern); any other end is a failure
+            if code == 0:
+                proc.transition(State.EXITED, "required process finished")
+                self.screen.message(f"orchestra: required process [{spec.name}] has finished; "
+                                    "shutting down", err=True)
+                self.request_stop(f"required process {spec.name} finished", exit_code=0)
+                return
             proc.transition(State.EXITED, f"required process died ({described})")
             self.screen.message(
                 f"orchestra: required process [{spec.name}] has died ({described}); "
