@@ -197,3 +197,20 @@ def test_pkg_show_prints_manifest_metadata_and_dependencies(env, tmp_path):
     assert "name: shown" in lines and "version: 1.0.0" in lines
     assert "build_depends: roscpp" in lines and "exec_depends: roscpp" in lines
     assert "no <maintainer>" in proc.stderr
+
+
+def test_install_space_package_brings_its_lib_dir_without_cmake_prefix_path(tmp_path, monkeypatch):
+    prefix = tmp_path / "opt_ros"
+    (prefix / "share").mkdir(parents=True)
+    (prefix / ".catkin").write_text("")
+    package(prefix / "share", "installed")
+    binary = script(prefix / "lib" / "installed" / "tool")
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(prefix / "share"))
+    monkeypatch.setenv("ROS_HOME", str(tmp_path / "rh"))
+    monkeypatch.delenv("CMAKE_PREFIX_PATH", raising=False)
+    monkeypatch.chdir(tmp_path)
+    reset_index()
+    try:
+        assert find_executable("installed", "tool") == str(binary)
+    finally:
+        reset_index()

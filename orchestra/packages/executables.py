@@ -12,7 +12,7 @@ import os
 from typing import Mapping
 
 from orchestra.errors import OrchestraError
-from orchestra.packages.discovery import catkin_prefixes, current_directory
+from orchestra.packages.discovery import CATKIN_MARKER, catkin_prefixes, current_directory
 from orchestra.packages.index import find_package
 
 
@@ -34,11 +34,23 @@ def is_executable(path: str) -> bool:
 
 
 def libexec_dirs(package: str, environ: Mapping[str, str] | None = None,
-                 cwd: str | None = None) -> list[str]:
-    """``lib/<pkg>`` and ``share/<pkg>`` of the first catkin prefix that has either."""
+                 cwd: str | None = None, package_dir: str | None = None) -> list[str]:
+    """``lib/<pkg>`` and ``share/<pkg>`` of the first catkin prefix that has either.
+
+    Besides CMAKE_PREFIX_PATH and the cwd workspace, a package found at
+    ``<prefix>/share/<pkg>`` of a catkin prefix brings that prefix along, so pointing only
+    ROS_PACKAGE_PATH at ``/opt/ros/noetic/share`` still finds the binaries in ``lib/``.
+    """
     env = os.environ if environ is None else environ
     here = current_directory() if cwd is None else cwd
-    for prefix in catkin_prefixes(env, here):
+    prefixes = catkin_prefixes(env, here)
+    if package_dir is not None:
+        share = os.path.dirname(os.path.abspath(package_dir))
+        owner = os.path.dirname(share)
+        if (os.path.basename(share) == "share" and owner not in prefixes
+                and os.path.isfile(os.path.join(owner, CATKIN_MARKER))):
+            prefixes.append(owner)
+    for prefix in prefixes:
         found = [d for d in (os.path.join(prefix, "lib", package),
                              os.path.join(prefix, "share", package)) if os.path.isdir(d)]
         if found:
@@ -89,7 +101,7 @@ def executable_candidates(package: str, exe: str, environ: Mapping[str, str] | N
         candidate = os.path.join(package_dir, exe)
         return [os.path.abspath(candidate)] if is_executable(candidate) else []
     libexec: list[str] = []
-    for top in libexec_dirs(package, environ, cwd):
+    for top in libexec_dirs(package, environ, cwd, package_dir):
         libexec += _walk_matches(top, exe)
     if libexec:
         return _unique(libexec)
