@@ -98,6 +98,14 @@ def test_args_read_by_eval_count_as_used_and_declared(ws):
     assert "'c'" in only(report, "undeclared-arg").message
 
 
+def test_args_handed_in_by_pass_all_args_need_no_declaration(ws):
+    write(ws / "launch", "inner.launch",
+          '<launch>\n  <param name="p" value="$(arg rate)"/>\n</launch>\n')
+    path = write(ws / "launch", "a.launch", '<launch>\n  <arg name="rate" default="1"/>\n'
+                 '  <include file="$(dirname)/inner.launch" pass_all_args="true"/>\n</launch>\n')
+    assert check_files([path]).problems == []
+
+
 def test_unused_arg_is_a_warning(ws):
     path = write(ws / "launch", "a.launch",
                  '<launch>\n  <arg name="used" default="1"/>\n  <arg name="idle" default="2"/>\n'
@@ -202,6 +210,19 @@ def test_yaml_launch_files_are_checked_with_yaml_columns(ws):
     assert (problem.location.line, problem.location.column) == (2, 42)
 
 
+def test_yaml_conversion_has_the_same_problems_as_the_xml(ws):
+    from orchestra.launch.convert import convert_file
+
+    xml_path = write(ws / "launch", "a.launch",
+                     '<launch>\n  <arg name="idle" default="1"/>\n'
+                     '  <node pkg="nopkg" type="t" name="n" respawn="true" required="true"/>\n'
+                     '  <param name="a" value="$(arg nope)"/>\n  <nod/>\n</launch>\n')
+    yaml_path = write(ws / "launch", "a.launch.yaml", convert_file(xml_path, "yaml"))
+    assert codes(check_files([yaml_path])) == codes(check_files([xml_path]))
+    assert codes(check_files([xml_path])) == ["missing-package", "respawn-required",
+                                              "undeclared-arg", "unknown-tag", "unused-arg"]
+
+
 def test_syntax_error_is_one_located_problem(ws):
     path = write(ws / "launch", "a.launch", "<launch>\n  <node\n</launch>\n")
     [problem] = check_files([path]).problems
@@ -265,4 +286,27 @@ def test_check_flags_every_smoke_file_roslaunch_rejects(compat_dir, monkeypatch)
         if item["ok"] and any(p.code not in ("unknown-tag",) for p in errors):
             false_alarms.append((item["launch_file"], [str(p) for p in errors]))
     assert missed == []
+    assert false_alarms == []
+
+
+@pytest.mark.timeout(120)
+def test_compat_cases_have_no_errors_but_missing_node_packages(compat_dir, monkeypatch):
+    """roslaunch loads all 80 cases with their args and env: check must not call any of them
+    broken, except for node packages the corpus does not ship."""
+    from orchestra.names import load_mappings
+
+    cases = json.loads((compat_dir / "cases.json").read_text())
+    false_alarms = []
+    for case in cases:
+        with monkeypatch.context() as env:
+            for name in list(os.environ):
+                if name != "PATH":
+                    env.delenv(name)
+            env.setenv("ROS_PACKAGE_PATH", str(compat_dir / "ws"))
+            env.setenv("ROS_DISTRO", "noetic")
+            for name, value in case["env"].items():
+                env.setenv(name, value)
+            args = load_mappings([f"{k}:={v}" for k, v in case["args"].items()])
+            report = check_files([str(compat_dir / "ws" / case["launch_file"])], args)
+        false_alarms += [str(p) for p in report.errors if p.code != "missing-package"]
     assert false_alarms == []

@@ -366,7 +366,7 @@ class Checker:
                 include = self._resolve_include(entity, scope, path, taken)
                 if include is not None:
                     includes.append(include)
-        self._check_args(path, declared, used, passes_all, top)
+        self._check_args(path, declared, used, passes_all, set(passed_args), top)
         for include in includes:
             self._check_file(include.target, include.args, top=False)
         return True
@@ -419,8 +419,11 @@ class Checker:
 
     # ---------------------------------------------------------------- args
     def _check_args(self, path: str, declared: dict[str, Entity], used: set[str],
-                    passes_all: bool, top: bool) -> None:
-        known = set(declared) | (set(self.cli_args) if top else set())
+                    passes_all: bool, passed: set[str], top: bool) -> None:
+        # args handed in (command line for the top file, pass_all_args or <arg> children of
+        # the include for others) are visible to $(arg) even when the file does not declare
+        # them, as in roslaunch
+        known = set(declared) | passed
         for name in sorted(used - known):
             entity = self._first_use(path, name)
             where = self.sources.locate(*entity) if entity else Location(path)
