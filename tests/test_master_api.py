@@ -442,3 +442,40 @@ def test_replaced_node_loses_its_param_subscriptions(master, m, slaves):
     m.setParam("/w", "/p", 1)
     assert master.api.notifier.wait_idle(5)
     assert [c[0] for c in old.calls] == ["shutdown"]
+
+
+def test_malformed_request_body_gets_a_fault_and_server_keeps_serving(master, m):
+    import urllib.request
+    req = urllib.request.Request(master.uri, data=b"<methodCall><not-xml",
+                                 headers={"Content-Type": "text/xml"})
+    with urllib.request.urlopen(req, timeout=5) as resp:
+        with pytest.raises(xmlrpc.client.Fault):
+            xmlrpc.client.loads(resp.read())
+    assert m.getPid("/x")[0] == 1
+
+
+def test_concurrent_clients_see_consistent_state(master):
+    errors: list[BaseException] = []
+
+    def worker(n: int) -> None:
+        try:
+            p = xmlrpc.client.ServerProxy(master.uri)
+            for i in range(50):
+                assert p.setParam(f"/w{n}", f"/w{n}/v", i)[0] == 1
+                assert p.getParam(f"/w{n}", f"/w{n}/v")[2] == i
+                p.registerPublisher(f"/w{n}", f"/t{i % 5}", "std_msgs/Int32",
+                                    f"http://127.0.0.1:{10000 + n}/")
+                p.getSystemState("/x")
+                p.getParam("/x", "/")
+        except BaseException as exc:  # noqa: BLE001 - reported below
+            errors.append(exc)
+    threads = [threading.Thread(target=worker, args=(n,)) for n in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(30)
+    assert errors == []
+    state = xmlrpc.client.ServerProxy(master.uri).getSystemState("/x")[2]
+    assert {topic: sorted(ids) for topic, ids in state[0]} == {
+        f"/t{i}": ["/w0", "/w1", "/w2", "/w3"] for i in range(5)}
+    assert {f"/w{n}/v" for n in range(4)} == set(master.params.names())
