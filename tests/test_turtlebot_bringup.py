@@ -79,7 +79,7 @@ PROBE = textwrap.dedent('''
 
     node.init_node("turtlebot_probe", anonymous=True)
     lock = threading.Lock()
-    seen = {"odom": [], "agg": None, "active": [], "ekf": None, "tf_static": []}
+    seen = {"odom": [], "agg": None, "active": [], "ekf": None, "tf_static": [], "tf": []}
 
     def keep(key, value, append=False):
         with lock:
@@ -99,6 +99,10 @@ PROBE = textwrap.dedent('''
                     lambda m: keep("ekf", [m.pose.pose.position.x, m.header.frame_id]))
     node.Subscriber("/tf_static", M("tf2_msgs/TFMessage"), lambda m: keep(
         "tf_static", [t.child_frame_id for t in m.transforms]))
+    def on_tf(m):
+        with lock:
+            seen["tf"] = sorted(set(seen["tf"]) | {t.child_frame_id for t in m.transforms})
+    node.Subscriber("/tf", M("tf2_msgs/TFMessage"), on_tf)
     teleop = node.Publisher("/cmd_vel_mux/input/teleop", M("geometry_msgs/Twist"))
 
     deadline = time.time() + float(sys.argv[1])
@@ -180,6 +184,8 @@ def test_teleop_twist_through_the_mux_moves_odom_and_diagnostics_are_aggregated(
     assert frame == "odom_combined"
     assert abs(ekf_x - (end[0] - start[0])) < 0.2
     assert {"base_link", "gyro_link", "camera_rgb_frame"} <= set(seen["tf_static"])
+    # /tf: odom -> base_footprint from the base, the wheels from joint_states via the URDF
+    assert {"base_footprint", "wheel_left_link", "wheel_right_link"} <= set(seen["tf"])
 
     # Ctrl-C stops the whole bring-up cleanly
     proc.send_signal(signal.SIGINT)

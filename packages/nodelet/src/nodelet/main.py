@@ -141,8 +141,17 @@ def run_standalone(type_name: str, extra: list[str]) -> int:
     node.init_node("nodelet")
     name = node.get_name()
     instance = load_plugin(type_name)(name, names.parse_remaps(sys.argv[1:], name), extra)
+    try:
+        instance.on_init()
+    except Exception as exc:
+        from nodelet.manager import is_user_error
+        instance.shutdown()
+        if not is_user_error(exc):
+            raise
+        node.logerr("nodelet %s (%s) failed to initialise: %s", name, type_name, exc)
+        node.signal_shutdown("init failed")
+        return 1
     node.on_shutdown(instance.shutdown)
-    instance.on_init()
     node.spin()
     return 0
 

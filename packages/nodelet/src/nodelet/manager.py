@@ -16,6 +16,13 @@ from nodelet.plugins import PluginError, load_plugin
 log = logging.getLogger("nodelet.manager")
 
 
+def is_user_error(exc: BaseException) -> bool:
+    """Configuration mistakes (missing/bad params, bad files) are reported as one line;
+    anything else is a plugin bug and deserves its traceback."""
+    from orchestra.errors import OrchestraError
+    return isinstance(exc, (OrchestraError, RuntimeError, ValueError, KeyError, OSError))
+
+
 class LoadError(Exception):
     """Why a load request was refused; the manager stays up, the loader reports it."""
 
@@ -45,7 +52,8 @@ class Manager:
                 instance.on_init()
             except Exception as exc:
                 instance.shutdown()
-                log.exception("nodelet %s (%s) failed in on_init", name, type_name)
+                if not is_user_error(exc):  # a bug in the plugin: keep the traceback
+                    log.exception("nodelet %s (%s) failed in on_init", name, type_name)
                 raise LoadError(f"'{type_name}' failed to initialise: {exc}") from None
         except BaseException:
             with self._lock:
