@@ -117,6 +117,12 @@ class Nodes:
         self.procs.append(proc)
         return proc
 
+    def start_orchestra(self, *args: str) -> NodeProcess:
+        """A long-running ``orchestra ...`` command (e.g. ``topic pub -r``)."""
+        proc = NodeProcess([sys.executable, "-m", "orchestra", *args], dict(self.env))
+        self.procs.append(proc)
+        return proc
+
     def master(self) -> xmlrpc.client.ServerProxy:
         return xmlrpc.client.ServerProxy(self.master_uri)
 

@@ -1,0 +1,185 @@
+"""``orchestra node|topic|service|graph`` against a live master and node processes."""
+from __future__ import annotations
+
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from lxml import etree
+
+sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
+from harness import Nodes, make_test_package, wait_for  # noqa: E402
+
+from orchestra.master import start_master  # noqa: E402
+
+pytestmark = pytest.mark.timeout(90)
+
+
+@pytest.fixture(scope="module")
+def package_path(tmp_path_factory) -> Path:
+    return make_test_package(tmp_path_factory.mktemp("pkgs"))
+
+
+@pytest.fixture
+def master():
+    handle = start_master(host="127.0.0.1", port=0)
+    yield handle
+    handle.shutdown()
+
+
+@pytest.fixture
+def nodes(master, package_path):
+    group = Nodes(master.uri, package_path)
+    yield group
+    group.close()
+
+
+def orchestra(nodes: Nodes, *args: str, timeout: float = 30) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "orchestra", *args], env=nodes.env,
+                          capture_output=True, text=True, timeout=timeout)
+
+
+def test_topic_echo_prints_yaml_documents_each_followed_by_dashes(nodes):
+    nodes.start("pub.py", "chatter", "std_msgs/String", "data: hello").ready()
+    result = orchestra(nodes, "topic", "echo", "chatter", "-n", "2")
+    assert result.returncode == 0, result.stderr
+    assert result.stdout == 'data: "hello"\n---\ndata: "hello"\n---\n'
+
+
+def test_topic_echo_decodes_a_type_it_has_no_definition_for(nodes, package_path):
+    nodes.start("pub.py", "nums", "test_msgs/Num", "{num: 4, label: four}").ready()
+    env_without_pkg = dict(nodes.env, ROS_PACKAGE_PATH="")
+    result = subprocess.run([sys.executable, "-m", "orchestra", "topic", "echo", "/nums",
+                             "-n", "1"], env=env_without_pkg, capture_output=True, text=True,
+                            timeout=30)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.startswith('num: 4\nlabel: "four"\nstamp: \n  secs: 0\n')
+
+
+def test_topic_pub_once_reaches_a_running_subscriber(nodes):
+    sub = nodes.start("sub.py", "cmd_vel", "geometry_msgs/Twist")
+    sub.ready()
+    result = orchestra(nodes, "topic", "pub", "-1", "/cmd_vel", "geometry_msgs/Twist",
+                       "{linear: {x: 0.5}, angular: {z: 1.0}}")
+    assert result.returncode == 0, result.stderr
+    assert sub.messages() == {"linear": {"x": 0.5, "y": 0.0, "z": 0.0},
+                              "angular": {"x": 0.0, "y": 0.0, "z": 1.0}}
+
+
+def test_topic_pub_at_a_rate_streams_messages(nodes):
+    sub = nodes.start("sub.py", "ticks", "std_msgs/Int32")
+    sub.ready()
+    pub = nodes.start_orchestra("topic", "pub", "-r", "50", "/ticks",
+                      "std_msgs/Int32", "7")
+    for _ in range(3):
+        assert sub.messages() == {"data": 7}
+    pub.kill()
+
+
+@pytest.mark.parametrize("args,message", [
+    (["/x", "std_msgs/String", "{data: [}"], "malformed YAML for std_msgs/String"),
+    (["/x", "std_msgs/String", "{dat: 1}"], "has no field dat"),
+    (["/x", "geometry_msgs/Twist", "{linear: {x: fast}}"], "must be a number"),
+    (["/x", "nope_msgs/Nothing", "{}"], "cannot find message type nope_msgs/Nothing"),
+])
+def test_topic_pub_rejects_bad_input_with_a_clear_error(nodes, args, message):
+    result = orchestra(nodes, "topic", "pub", "-1", *args)
+    assert result.returncode == 2
+    assert message in result.stderr
+    assert "Traceback" not in result.stderr
+
+
+def test_topic_list_info_and_type(nodes):
+    nodes.start("pub.py", "chatter", "std_msgs/String", "data: a", "--name", "talker").ready()
+    nodes.start("sub.py", "chatter", "std_msgs/String", "--name", "listener").ready()
+    listed = orchestra(nodes, "topic", "list").stdout.split()
+    assert "/chatter" in listed and "/rosout" in listed
+    info = orchestra(nodes, "topic", "info", "/chatter").stdout
+    assert info.startswith("Type: std_msgs/String\n\nPublishers: \n * /talker (http://")
+    assert "Subscribers: \n * /listener (http://" in info
+    assert orchestra(nodes, "topic", "type", "chatter").stdout == "std_msgs/String\n"
+    missing = orchestra(nodes, "topic", "type", "/nothing")
+    assert missing.returncode == 2 and "unknown topic /nothing" in missing.stderr
+
+
+def test_topic_hz_reports_the_average_rate(nodes):
+    nodes.start("pub.py", "fast", "std_msgs/Empty", "{}", "--rate", "50").ready()
+    result = orchestra(nodes, "topic", "hz", "/fast", "-n", "2")
+    assert result.returncode == 0, result.stderr
+    rates = [float(line.split(":")[1]) for line in result.stdout.splitlines()
+             if line.startswith("average rate")]
+    assert rates and 30 < rates[-1] < 70
+    assert "\tmin: " in result.stdout and "window: " in result.stdout
+
+
+def test_service_list_type_info_and_call(nodes):
+    nodes.start("adder.py", "add").ready()
+    assert orchestra(nodes, "service", "list").stdout.split() == ["/add"]
+    assert orchestra(nodes, "service", "type", "/add").stdout == "test_msgs/AddTwoInts\n"
+    info = orchestra(nodes, "service", "info", "add").stdout
+    assert "Node: /adder\nURI: rosrpc://127.0.0.1:" in info and "Args: a b" in info
+    result = orchestra(nodes, "service", "call", "/add", "{a: 20, b: 22}")
+    assert (result.returncode, result.stdout) == (0, "sum: 42\n")
+    positional = orchestra(nodes, "service", "call", "/add", "1", "2")
+    assert positional.stdout == "sum: 3\n"
+    failed = orchestra(nodes, "service", "call", "/add", "{a: -3, b: 0}")
+    assert failed.returncode == 1 and "responded with an error" in failed.stderr
+    assert "negative a: -3" in failed.stderr
+    bad = orchestra(nodes, "service", "call", "/add", "{a: [}")
+    assert bad.returncode == 2 and "malformed YAML" in bad.stderr
+    unknown = orchestra(nodes, "service", "call", "/nope", "{}")
+    assert unknown.returncode == 2 and "service [/nope] is not available" in unknown.stderr
+
+
+def test_node_list_info_and_kill(nodes):
+    pub = nodes.start("pub.py", "chatter", "std_msgs/String", "data: a", "--name", "talker")
+    pub.ready()
+    nodes.start("sub.py", "chatter", "std_msgs/String", "--name", "listener").ready()
+    assert orchestra(nodes, "node", "list").stdout.split() == ["/listener", "/talker"]
+    wait_for(lambda: "* to: /listener" in orchestra(nodes, "node", "info", "/talker").stdout)
+    info = orchestra(nodes, "node", "info", "/talker").stdout
+    assert "Publications: \n * /chatter [std_msgs/String]" in info
+    assert f"Pid: {pub.proc.pid}" in info
+    killed = orchestra(nodes, "node", "kill", "/talker")
+    assert killed.returncode == 0 and "killing /talker" in killed.stdout
+    assert pub.wait() == 0
+    assert orchestra(nodes, "node", "list").stdout.split() == ["/listener"]
+    unknown = orchestra(nodes, "node", "kill", "/ghost")
+    assert unknown.returncode == 1 and "unknown node [/ghost]" in unknown.stderr
+
+
+def test_graph_writes_dot_and_svg_with_nodes_and_topics(nodes, tmp_path):
+    nodes.start("pub.py", "chatter", "std_msgs/String", "data: a", "--name", "talker").ready()
+    nodes.start("sub.py", "chatter", "std_msgs/String", "--name", "listener").ready()
+    dot = orchestra(nodes, "graph").stdout
+    assert '"/talker" -> "t:/chatter";' in dot and '"t:/chatter" -> "/listener";' in dot
+    assert "/rosout" not in dot
+    out = tmp_path / "g.svg"
+    result = orchestra(nodes, "graph", "--out", str(out))
+    assert result.returncode == 0, result.stderr
+    svg = etree.parse(str(out)).getroot()
+    ns = {"s": "http://www.w3.org/2000/svg"}
+    labels = [t.text for t in svg.iterfind(".//s:text", ns)]
+    assert sorted(labels) == ["/chatter", "/listener", "/talker"]
+    assert len(svg.findall(".//s:line", ns)) == 2
+    png = orchestra(nodes, "graph", "--out", str(tmp_path / "g.png"))
+    assert png.returncode == 2 and "use --out graph.svg" in png.stderr
+
+
+def test_commands_fail_cleanly_without_a_master(nodes):
+    import socket
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    env = dict(nodes.env, ROS_MASTER_URI=f"http://127.0.0.1:{port}/")
+    started = time.monotonic()
+    result = subprocess.run([sys.executable, "-m", "orchestra", "topic", "echo", "/x"],
+                            env=env, capture_output=True, text=True, timeout=30)
+    assert result.returncode == 1
+    assert "cannot contact the master" in result.stderr and "Traceback" not in result.stderr
+    assert time.monotonic() - started < 10
+    listing = subprocess.run([sys.executable, "-m", "orchestra", "node", "list"], env=env,
+                             capture_output=True, text=True, timeout=30)
+    assert listing.returncode == 1 and "cannot contact the master" in listing.stderr
