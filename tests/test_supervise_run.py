@@ -49,6 +49,22 @@ def free_port() -> int:
 
 @pytest.fixture
 def run_env(tmp_path, monkeypatch):
+    """A workspace with the probe node and a master already up at ROS_MASTER_URI."""
+    from orchestra.master import start_master
+
+    env = _workspace(tmp_path, monkeypatch)
+    master = start_master("127.0.0.1", env["port"])
+    yield env
+    master.shutdown()
+
+
+@pytest.fixture
+def no_master_env(tmp_path, monkeypatch):
+    """The same workspace with nobody at ROS_MASTER_URI: orchestra embeds the master."""
+    return _workspace(tmp_path, monkeypatch)
+
+
+def _workspace(tmp_path, monkeypatch):
     ws = tmp_path / "ws"
     nodes = ws / "demo" / "nodes"
     nodes.mkdir(parents=True)
@@ -168,9 +184,10 @@ def test_screen_and_log_together_is_a_user_error():
         run_plan(LaunchPlan(), {"force_screen": True, "force_log": True})
 
 
-def test_missing_executable_fails_before_anything_starts(run_env):
+def test_missing_executable_fails_before_anything_starts(no_master_env):
     from orchestra.master import master_is_up
 
+    run_env = no_master_env
     plan = LaunchPlan(nodes=(Node("demo", "probe", "ok"),
                              Node("demo", "nope", "bad", filename="/x/demo.launch", line=9)))
     with pytest.raises(OrchestraError) as info:
@@ -189,6 +206,33 @@ def test_remote_machine_needs_local_flag(run_env):
         run_plan(plan, OPTS)
     assert "r.launch:3: " in str(info.value) and "--local" in str(info.value)
     assert run_plan(plan, dict(OPTS, local=True)) == 0
+
+
+def test_embedded_master_keeps_the_launch_up_after_nodes_end(no_master_env):
+    import signal
+
+    returned = threading.Event()
+    probe_file = no_master_env["out"] / "probe.json"
+
+    def stop_later() -> None:
+        deadline = time.monotonic() + 20
+        while not probe_file.exists() and time.monotonic() < deadline:
+            time.sleep(0.02)
+        time.sleep(0.3)
+        still_running.append(not returned.is_set())
+        os.kill(os.getpid(), signal.SIGTERM)
+
+    still_running: list[bool] = []
+    thread = threading.Thread(target=stop_later)
+    thread.start()
+    try:
+        code = run_plan(LaunchPlan(params={"/p": 1}, nodes=(Node("demo", "probe", "probe"),)),
+                        OPTS)
+    finally:
+        returned.set()
+        thread.join()
+    assert code == 0 and still_running == [True]
+    assert record(no_master_env, "probe")["param"] == 1
 
 
 def test_bad_node_timeout_option_is_a_user_error(run_env):

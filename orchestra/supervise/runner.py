@@ -288,7 +288,8 @@ def run_plan(plan: LaunchPlan, options: Mapping[str, Any]) -> int:
         supervisor = Supervisor(specs, RestartPolicy(backoff_max=opts.backoff_max,
                                                      crash_limit=opts.crash_limit),
                                 screen=screen, log_dir=run_dir, watchdog=watchdog,
-                                log_max_bytes=opts.log_max_bytes, log_backups=opts.log_backups)
+                                log_max_bytes=opts.log_max_bytes, log_backups=opts.log_backups,
+                                keep_alive=master.handle is not None)
         stats = ProcessStats()
         info = {"run_id": master.run_id, "master_uri": master.uri,
                 "launch_files": list(plan.files_loaded), "log_dir": run_dir}

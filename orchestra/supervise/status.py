@@ -225,7 +225,7 @@ class LiveView:
 
     def _max_lines(self) -> int:
         try:
-            rows = os.get_terminal_size().lines
+            rows = os.get_terminal_size().lines or 24   # 0 on a pty nobody sized
         except OSError:
             rows = 24
         return max(3, rows // 3)

@@ -57,7 +57,7 @@ class Supervisor:
                  screen: Screen | None = None, log_dir: str | None = None,
                  watchdog: Watchdog | None = None, log_max_bytes: int = 0,
                  log_backups: int = 5, on_change: Callable[[], None] | None = None,
-                 pdeathsig: str = "auto"):
+                 pdeathsig: str = "auto", keep_alive: bool = False):
         names = [s.name for s in specs]
         if len(set(names)) != len(names):
             raise ValueError("process names must be unique")
@@ -73,6 +73,9 @@ class Supervisor:
         if pdeathsig not in ("setpriv", "preexec", "off"):
             raise ValueError(f"pdeathsig must be auto, setpriv, preexec or off: {pdeathsig!r}")
         self.pdeathsig = pdeathsig
+        # keep_alive: run until stopped even when every process ended (orchestra serving its
+        # embedded master is like roslaunch having started roscore: it stays up)
+        self.keep_alive = keep_alive
         self.loop = EventLoop()
         self.procs = [ManagedProcess(spec, start_index=i) for i, spec in enumerate(specs)]
         self.outputs = {
@@ -139,6 +142,8 @@ class Supervisor:
                 self._escalate(proc, signal.SIGKILL)
 
     def done(self) -> bool:
+        if self.keep_alive and not self.stopping:
+            return False
         return all(p.state in TERMINAL for p in self.procs)
 
     def run(self, install_signals: bool = True) -> RunResult:
