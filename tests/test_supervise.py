@@ -398,3 +398,17 @@ def test_script_without_shebang_is_a_spawn_failure_in_every_mode(tmp_path):
         run(sup)
         assert sup.procs[0].state == State.FAILED
         assert "Exec format error" in sup.procs[0].reason
+
+
+def test_without_pidfd_a_waiter_thread_reports_exits(tmp_path, monkeypatch):
+    from orchestra.supervise import supervisor as supervisor_module
+
+    monkeypatch.setattr(supervisor_module, "_HAS_PIDFD", False)
+    specs = [sh("/steady", "sleep 100", tmp_path),
+             sh("/crashy", "echo bye; exit 2", tmp_path, respawn=True)]
+    screen = quiet_screen()
+    sup = Supervisor(specs, RestartPolicy(stable_after=0.0, crash_limit=0), screen=screen)
+    result = run(sup, until=lambda: sup.procs[1].restarts >= 3)
+    assert result.exit_code == 0
+    assert sup.procs[0].state == State.EXITED and sup.procs[0].exit_code == -signal.SIGINT
+    assert screen.out.getvalue().count(b"[/crashy] bye\n") >= 3

@@ -2,7 +2,9 @@
 
 Takes plain ProcessSpecs (no launch plan, no master), so it is tested and benchmarked on its
 own. One event loop (``loop.py``) watches, per child, a pidfd (exit) and two pipes (output);
-plus the signal wake-up pipe and the status socket. Nothing polls.
+plus the signal wake-up pipe and the status socket. Nothing polls. Where pidfds do not exist
+(Linux < 5.3, other Unixes) a thread per child blocks in ``wait`` and hands the exit to the
+loop instead.
 
 Exit code of a run: 0 when stopped on request, when every node ended by itself, or when a
 required node finished with exit code 0; 1 when a required node died (signal or non-zero
@@ -10,6 +12,7 @@ exit) or failed to start, or when any node ended FAILED (the message says which)
 """
 from __future__ import annotations
 
+import errno
 import logging
 import os
 import signal
@@ -45,7 +48,7 @@ class _Child:
     """OS handles of one running instance of a process."""
 
     popen: subprocess.Popen
-    pidfd: int
+    pidfd: int | None      # None: a waiter thread reports the exit instead
     ps: psutil.Process | None = None
     extra: list[int] = field(default_factory=list)   # descendants outside the process group
 
@@ -179,18 +182,22 @@ class Supervisor:
             elif self.pdeathsig == "preexec":
                 preexec = child_setup(self._pid)
             popen = subprocess.Popen(
-                argv, cwd=spec.cwd, env=dict(spec.env), stdin=subprocess.DEVNULL,
+                argv, cwd=spec.cwd, env=dict(spec.env), stdin=None,  # inherited, as roslaunch
                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, close_fds=True,
                 start_new_session=True, preexec_fn=preexec)
         except (OSError, subprocess.SubprocessError) as exc:
             self._spawn_failed(proc, exc)
             return
-        pidfd = os.pidfd_open(popen.pid)
+        pidfd = _pidfd_open(popen.pid)
         child = _Child(popen, pidfd)
         self._children[spec.name] = child
         if self.watchdog is not None:
             self.watchdog.watch(popen.pid)
-        self.loop.add_reader(pidfd, lambda: self._on_exit(proc))
+        if pidfd is not None:
+            self.loop.add_reader(pidfd, lambda: self._on_exit(proc))
+        else:
+            threading.Thread(target=self._wait_in_thread, args=(proc, popen), daemon=True,
+                             name=f"wait {spec.name}").start()
         output = self.outputs[spec.name]
         for stream, pipe in (("out", popen.stdout), ("err", popen.stderr)):
             fd = pipe.fileno()
@@ -239,11 +246,19 @@ class Supervisor:
             if pipe is not None and not pipe.closed:
                 self._on_output(pipe.fileno(), stream, pipe, output)
 
-    def _on_exit(self, proc: ManagedProcess) -> None:
+    def _wait_in_thread(self, proc: ManagedProcess, popen: subprocess.Popen) -> None:
+        popen.wait()
+        self.loop.call_threadsafe(lambda: self._on_exit(proc, popen))
+
+    def _on_exit(self, proc: ManagedProcess, popen: subprocess.Popen | None = None) -> None:
         spec = proc.spec
-        child = self._children.pop(spec.name)
-        self.loop.remove_reader(child.pidfd)
-        os.close(child.pidfd)
+        child = self._children.get(spec.name)
+        if child is None or (popen is not None and child.popen is not popen):
+            return    # a late report about an instance already handled
+        del self._children[spec.name]
+        if child.pidfd is not None:
+            self.loop.remove_reader(child.pidfd)
+            os.close(child.pidfd)
         code = child.popen.wait()
         # whatever the node left behind in its group (and strays seen at stop) goes with it
         signal_group(child.popen.pid, signal.SIGKILL, child.extra)
@@ -373,7 +388,8 @@ class Supervisor:
         for child in self._children.values():  # only after an internal error
             signal_group(child.popen.pid, signal.SIGKILL, child.extra)
             child.popen.wait()
-            os.close(child.pidfd)
+            if child.pidfd is not None:
+                os.close(child.pidfd)
         self._children.clear()
         self.loop.close()
 
@@ -385,6 +401,21 @@ class Supervisor:
             result.exit_code = 1
             result.reason = result.reason + "; failed: " + ", ".join(failed)
         return result
+
+
+def _pidfd_open(pid: int) -> int | None:
+    """A pidfd for ``pid``, or None where the kernel/Python has none."""
+    if not _HAS_PIDFD:
+        return None
+    try:
+        return os.pidfd_open(pid)
+    except OSError as exc:
+        if exc.errno in (errno.ENOSYS, errno.EPERM, errno.EINVAL):
+            return None
+        raise
+
+
+_HAS_PIDFD = hasattr(os, "pidfd_open") and os.environ.get("ORCHESTRA_NO_PIDFD") != "1"
 
 
 def _pgid(pid: int) -> int | None:
