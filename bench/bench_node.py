@@ -1,0 +1,332 @@
+#!/usr/bin/env python3
+"""Node runtime speed: one-way latency and throughput of topics, service calls per second.
+
+Every figure is measured here, in one run, next to a baseline measured the same way on the
+same machine: plain Python processes exchanging the same bytes over a loopback TCP socket
+with no ROS layer at all. Ratios (orchestra / baseline) are what to compare between
+machines; absolute numbers depend on the CPU and on what else runs.
+
+    python bench/bench_node.py            # full run (~1 minute)
+    python bench/bench_node.py --quick    # fewer samples
+
+Processes: an in-process master, then a publisher process and a subscriber process (or a
+service and a client process). One-way latency = receive time - send time, both read from
+CLOCK_MONOTONIC, which every process on the machine shares.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import socket
+import statistics
+import struct
+import subprocess
+import sys
+import time
+
+HERE = os.path.abspath(__file__)
+IMAGE_BYTES = 640 * 480 * 3
+
+
+def now() -> float:
+    return time.monotonic()
+
+
+def summarize(latencies: list[float]) -> dict:
+    ordered = sorted(latencies)
+    p99 = ordered[min(len(ordered) - 1, int(len(ordered) * 0.99))]
+    return {"median_us": statistics.median(ordered) * 1e6, "p99_us": p99 * 1e6,
+            "n": len(ordered)}
+
+
+def emit(obj: dict) -> None:
+    sys.stdout.write(json.dumps(obj) + "\n")
+    sys.stdout.flush()
+
+
+# --- roles run in child processes ----------------------------------------------------------------
+
+def make_message(kind: str):
+    from orchestra.node.msg import get_message_class
+    if kind == "twist":
+        return get_message_class("geometry_msgs/Twist")()
+    img = get_message_class("sensor_msgs/Image")(height=480, width=640, encoding="rgb8",
+                                                  step=640 * 3, data=bytes(IMAGE_BYTES))
+    return img
+
+
+def stamp(kind: str, msg, t: float) -> None:
+    if kind == "twist":
+        msg.linear.x = t
+    else:
+        msg.header.stamp.secs, msg.header.stamp.nsecs = int(t), int((t % 1) * 1e9)
+
+
+def read_stamp(kind: str, msg) -> float:
+    if kind == "twist":
+        return msg.linear.x
+    return msg.header.stamp.secs + msg.header.stamp.nsecs / 1e9
+
+
+def role_sub(kind: str, count: int, burst: int) -> None:
+    import threading
+
+    import orchestra.node as rospy
+    msg = make_message(kind)
+    latencies: list[float] = []
+    burst_times: list[float] = []
+    done = threading.Event()
+
+    def callback(m):
+        t = now()
+        if m.angular.z if kind == "twist" else m.header.frame_id == "burst":
+            burst_times.append(t)
+            if len(burst_times) >= burst:
+                done.set()
+        else:
+            latencies.append(t - read_stamp(kind, m))
+
+    rospy.init_node(f"bench_sub_{kind}", disable_signals=True)
+    rospy.Subscriber("/bench", type(msg), callback, queue_size=burst)
+    emit({"ready": True})
+    line = sys.stdin.readline()  # "latency done" from the parent
+    emit({"latency": summarize(latencies)})
+    done.wait(float(line.split()[-1]) if line.strip() else 30.0)
+    received = len(burst_times)
+    span = burst_times[-1] - burst_times[0] if received > 1 else float("nan")
+    emit({"throughput": {"received": received, "msgs_per_s": (received - 1) / span,
+                         "mb_per_s": (received - 1) * len(msg.serialize_bytes()) / span / 1e6}})
+    rospy.signal_shutdown("done")
+
+
+def role_pub(kind: str, count: int, burst: int) -> None:
+    import orchestra.node as rospy
+    msg = make_message(kind)
+    rospy.init_node(f"bench_pub_{kind}", disable_signals=True)
+    pub = rospy.Publisher("/bench", type(msg), queue_size=burst)
+    while pub.get_num_connections() < 1:
+        time.sleep(0.01)
+    time.sleep(0.2)
+    gap = 0.002 if kind == "twist" else 0.01
+    for _ in range(count):
+        stamp(kind, msg, now())
+        pub.publish(msg)
+        time.sleep(gap)
+    time.sleep(0.3)
+    emit({"latency_sent": count})
+    sys.stdin.readline()  # go for the burst
+    if kind == "twist":
+        msg.angular.z = 1.0
+    else:
+        msg.header.frame_id = "burst"
+    for _ in range(burst):
+        pub.publish(msg)
+    impl = pub._impl
+    deadline = now() + 30
+    while now() < deadline and any(c.queue for c in impl.connections):
+        time.sleep(0.01)
+    emit({"burst_sent": burst})
+    sys.stdin.readline()
+    rospy.signal_shutdown("done")
+
+
+def role_service() -> None:
+    import orchestra.node as rospy
+    from orchestra.node.msg import get_service_class
+    Trigger = get_service_class("std_srvs/SetBool")
+    rospy.init_node("bench_service", disable_signals=True)
+    rospy.Service("/bench_srv", Trigger, lambda req: Trigger.Response(success=req.data))
+    emit({"ready": True})
+    sys.stdin.readline()
+    rospy.signal_shutdown("done")
+
+
+def role_client(calls: int) -> None:
+    import orchestra.node as rospy
+    from orchestra.node.msg import get_service_class
+    SetBool = get_service_class("std_srvs/SetBool")
+    rospy.init_node("bench_client", disable_signals=True)
+    rospy.wait_for_service("/bench_srv", timeout=10)
+    out = {}
+    for persistent in (False, True):
+        proxy = rospy.ServiceProxy("/bench_srv", SetBool, persistent=persistent)
+        proxy(data=True)
+        start = now()
+        for _ in range(calls):
+            assert proxy(data=True).success
+        out["persistent" if persistent else "plain"] = calls / (now() - start)
+        if persistent:
+            proxy.close()
+    emit({"calls_per_s": out})
+    rospy.signal_shutdown("done")
+
+
+# --- baseline: the same bytes over a bare socket -------------------------------------------------
+
+def role_raw_server(size: int, count: int, burst: int) -> None:
+    srv = socket.socket()
+    srv.bind(("127.0.0.1", 0))
+    srv.listen(1)
+    emit({"port": srv.getsockname()[1]})
+    conn, _ = srv.accept()
+    conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+    f = conn.makefile("rb")
+    lat: list[float] = []
+    for _ in range(count):
+        (n,) = struct.unpack("<I", f.read(4))
+        body = f.read(n)
+        lat.append(now() - struct.unpack_from("<d", body)[0])
+    times = []
+    for _ in range(burst):
+        (n,) = struct.unpack("<I", f.read(4))
+        f.read(n)
+        times.append(now())
+    span = times[-1] - times[0]
+    emit({"latency": summarize(lat), "throughput": {"msgs_per_s": (burst - 1) / span,
+                                                    "mb_per_s": (burst - 1) * size / span / 1e6}})
+    # request/response round trips for the service baseline
+    while True:
+        head = f.read(4)
+        if len(head) < 4:
+            break
+        (n,) = struct.unpack("<I", head)
+        f.read(n)
+        conn.sendall(b"\x01" + struct.pack("<I", 1) + b"\x01")
+
+
+def raw_baseline(size: int, count: int, burst: int, calls: int, gap: float) -> dict:
+    proc = subprocess.Popen([sys.executable, HERE, "--role", "raw_server", "--size", str(size),
+                             "--count", str(count), "--burst", str(burst)],
+                            stdout=subprocess.PIPE, text=True)
+    port = json.loads(proc.stdout.readline())["port"]
+    sock = socket.create_connection(("127.0.0.1", port))
+    sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+    payload = bytearray(size)
+    for _ in range(count):
+        struct.pack_into("<d", payload, 0, now())
+        sock.sendall(struct.pack("<I", size) + payload)
+        time.sleep(gap)
+    for _ in range(burst):
+        sock.sendall(struct.pack("<I", size) + payload)
+    result = json.loads(proc.stdout.readline())
+    f = sock.makefile("rb")
+    start = now()
+    for _ in range(calls):
+        sock.sendall(struct.pack("<I", 1) + b"\x01")
+        f.read(6)
+    result["calls_per_s"] = calls / (now() - start)
+    f.close()
+    sock.close()
+    proc.wait(10)
+    return result
+
+
+# --- driver ---------------------------------------------------------------------------------------
+
+def child(env: dict, *args: str) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, HERE, *args], env=env, stdin=subprocess.PIPE,
+                            stdout=subprocess.PIPE, text=True)
+
+
+def read(proc: subprocess.Popen, key: str) -> dict:
+    while True:
+        line = proc.stdout.readline()
+        if not line:
+            raise RuntimeError(f"child ended before reporting {key}")
+        data = json.loads(line)
+        if key in data:
+            return data
+
+
+def tell(proc: subprocess.Popen, text: str = "") -> None:
+    proc.stdin.write(text + "\n")
+    proc.stdin.flush()
+
+
+def bench_topic(env: dict, kind: str, count: int, burst: int) -> dict:
+    sub = child(env, "--role", "sub", "--kind", kind, "--count", str(count), "--burst", str(burst))
+    read(sub, "ready")
+    pub = child(env, "--role", "pub", "--kind", kind, "--count", str(count), "--burst", str(burst))
+    read(pub, "latency_sent")
+    tell(sub, "latency done 30")
+    latency = read(sub, "latency")["latency"]
+    tell(pub)
+    read(pub, "burst_sent")
+    throughput = read(sub, "throughput")["throughput"]
+    tell(pub)
+    for proc in (pub, sub):
+        proc.wait(15)
+    return {"latency": latency, "throughput": throughput}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--role", default=None)
+    parser.add_argument("--kind", default="twist")
+    parser.add_argument("--count", type=int, default=2000)
+    parser.add_argument("--burst", type=int, default=5000)
+    parser.add_argument("--size", type=int, default=48)
+    parser.add_argument("--calls", type=int, default=2000)
+    parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--json", action="store_true", help="Print one JSON document.")
+    opts = parser.parse_args()
+    if opts.role == "sub":
+        return role_sub(opts.kind, opts.count, opts.burst)
+    if opts.role == "pub":
+        return role_pub(opts.kind, opts.count, opts.burst)
+    if opts.role == "service":
+        return role_service()
+    if opts.role == "client":
+        return role_client(opts.calls)
+    if opts.role == "raw_server":
+        return role_raw_server(opts.size, opts.count, opts.burst)
+
+    scale = 0.25 if opts.quick else 1.0
+    from orchestra.master import start_master
+    master = start_master(host="127.0.0.1", port=0)
+    env = dict(os.environ, ROS_MASTER_URI=master.uri, PYTHONUNBUFFERED="1")
+    results: dict = {}
+    try:
+        plan = {"twist": (int(2000 * scale), int(5000 * scale), 48, 0.002),
+                "image": (int(200 * scale), int(300 * scale), IMAGE_BYTES + 70, 0.01)}
+        for kind, (count, burst, size, gap) in plan.items():
+            results[kind] = bench_topic(env, kind, count, burst)
+            results[kind]["baseline"] = raw_baseline(size, count, burst, 10, gap)
+        svc = child(env, "--role", "service")
+        read(svc, "ready")
+        calls = int(opts.calls * scale)
+        cli = child(env, "--role", "client", "--calls", str(calls))
+        results["service"] = read(cli, "calls_per_s")["calls_per_s"]
+        cli.wait(30)
+        tell(svc)
+        svc.wait(15)
+        results["service"]["baseline"] = raw_baseline(8, 1, 2, calls, 0)["calls_per_s"]
+    finally:
+        master.shutdown()
+    if opts.json:
+        print(json.dumps(results, indent=2))
+        return
+    print(f"{'':36}{'orchestra':>14}{'raw socket':>14}{'ratio':>9}")
+    for kind, label in (("twist", "Twist"), ("image", "Image 640x480")):
+        r = results[kind]
+        base = r["baseline"]
+        for key, name in (("median_us", "latency median (us)"), ("p99_us", "latency p99 (us)")):
+            print(f"{label + ' ' + name:36.36}{r['latency'][key]:14.1f}{base['latency'][key]:14.1f}"
+                  f"{r['latency'][key] / base['latency'][key]:9.1f}")
+        print(f"{label + ' msgs/s':36.36}{r['throughput']['msgs_per_s']:14.0f}"
+              f"{base['throughput']['msgs_per_s']:14.0f}"
+              f"{base['throughput']['msgs_per_s'] / r['throughput']['msgs_per_s']:9.1f}")
+        print(f"{label + ' MB/s':36.36}{r['throughput']['mb_per_s']:14.1f}"
+              f"{base['throughput']['mb_per_s']:14.1f}")
+        print(f"{label + ' received/sent':36.36}{r['throughput']['received']:>14}"
+              f"{plan[kind][1]:>14}")
+    s = results["service"]
+    for key in ("plain", "persistent"):
+        print(f"{'service calls/s ' + key:36}{s[key]:14.0f}{s['baseline']:14.0f}"
+              f"{s['baseline'] / s[key]:9.1f}")
+    print("ratio = how many times slower than the bare-socket baseline (lower is better)")
+
+
+if __name__ == "__main__":
+    main()
