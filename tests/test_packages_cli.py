@@ -214,3 +214,21 @@ def test_install_space_package_brings_its_lib_dir_without_cmake_prefix_path(tmp_
         assert find_executable("installed", "tool") == str(binary)
     finally:
         reset_index()
+
+
+def test_pkg_plugins_lists_exports_of_packages_depending_on_the_tool(env, tmp_path):
+    package(env, "tool")
+    user = package(env, "user", ["tool"])
+    (user / "package.xml").write_text(
+        "<package format='2'><name>user</name><version>1.0.0</version><description>x</description>"
+        "<depend>tool</depend><export><tool plugin='${prefix}/plugins.xml'/></export></package>")
+    stranger = package(env, "stranger")
+    (stranger / "package.xml").write_text(  # exports for the tool without depending on it
+        "<package format='2'><name>stranger</name><version>1.0.0</version><description>x</description>"
+        "<export><tool plugin='${prefix}/p.xml'/></export></package>")
+    broken = env / "broken"
+    broken.mkdir()
+    (broken / "package.xml").write_text("<package><name>broken</name><tool")
+    proc = cli("pkg", "plugins", "tool", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.splitlines() == [f"user {user}/plugins.xml"]

@@ -78,6 +78,19 @@ def show_cmd(name: str) -> None:
         click.echo(f"orchestra: warning: {manifest.path}: {warning}", err=True)
 
 
+@pkg.command("plugins")
+@click.argument("tool")
+@click.option("--attrib", default="plugin", show_default=True,
+              help="Attribute of the <TOOL> export tag to print.")
+def plugins_cmd(tool: str, attrib: str) -> None:
+    """Exports for TOOL (rospack plugins): `package value` for each package depending on TOOL
+    whose package.xml has <export><TOOL ATTRIB="value"/></export>."""
+    from orchestra.packages.plugins import find_plugins
+
+    for export in find_plugins(tool, attrib):
+        click.echo(f"{export.package} {export.value}")
+
+
 @pkg.command("roots")
 def roots_cmd() -> None:
     """The directories searched for packages, highest priority first."""
