@@ -301,3 +301,15 @@ def test_concurrent_writers_and_readers_never_see_a_partial_cache_file(tmp_path)
         _, err = proc.communicate(timeout=100)
         assert proc.returncode == 0, err
     assert [n for n in os.listdir(cache_dir) if n.endswith(".tmp")] == []
+
+
+def test_package_created_after_the_index_was_built_is_found_on_miss(tmp_path, monkeypatch):
+    make_pkg(tmp_path / "rpp" / "early")
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(tmp_path / "rpp"))
+    monkeypatch.setenv("ROS_HOME", str(tmp_path / "rh"))
+    monkeypatch.chdir(tmp_path)
+    assert find_package("early")
+    make_pkg(tmp_path / "rpp" / "late")
+    assert find_package("late") == str(tmp_path / "rpp" / "late")
+    with pytest.raises(PackageNotFound):
+        find_package("never")

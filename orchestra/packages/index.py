@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import logging
 import os
+import time
 from dataclasses import dataclass, field
 
 from orchestra.errors import OrchestraError
@@ -107,10 +108,31 @@ def get_index(refresh: bool = False) -> PackageIndex:
 
 def reset_index() -> None:
     """Forget the process-wide index (tests; tools that just created a package)."""
-    global _INDEX
+    global _INDEX, _last_miss_refresh
     _INDEX = None
+    _last_miss_refresh = float("-inf")
+
+
+#: a miss re-validates the index (a package may have been created since it was built), at
+#: most this often, so code probing many absent names does not re-crawl each time
+MISS_REFRESH_INTERVAL = 1.0
+_last_miss_refresh = float("-inf")
 
 
 def find_package(name: str) -> str:
-    """The directory of package ``name`` (what ``$(find name)`` and ``rospack find`` return)."""
-    return get_index().find(name)
+    """The directory of package ``name`` (what ``$(find name)`` and ``rospack find`` return).
+
+    A hit is a dict lookup. A miss first re-validates the index against the disk (cheap with
+    a warm cache) in case the package appeared since the index was built, then raises
+    ``PackageNotFound``.
+    """
+    global _last_miss_refresh
+    index = get_index()
+    directory = index.packages.get(name)
+    if directory is not None:
+        return directory
+    now = time.monotonic()
+    if now - _last_miss_refresh >= MISS_REFRESH_INTERVAL:
+        _last_miss_refresh = now
+        index = get_index(refresh=True)
+    return index.find(name)
