@@ -134,12 +134,13 @@ def test_bad_analyzer_configs_are_rejected(spec, message):
         build_analyzers(spec)
 
 
-def test_turtlebot_kobuki_config_sorts_every_base_diagnostic():
+@pytest.mark.parametrize("config_file", ["turtlebot_bringup/param/kobuki/diagnostics.yaml",
+                                         "kobuki_node/param/diagnostics.yaml"])
+def test_kobuki_diagnostics_configs_sort_every_base_diagnostic(config_file):
     sys.path.insert(0, str(PACKAGES / "kobuki_node" / "src"))
     from kobuki_node.base import KobukiBase
 
-    config = yaml.safe_load((PACKAGES / "turtlebot_bringup" / "param" / "kobuki"
-                             / "diagnostics.yaml").read_text())
+    config = yaml.safe_load((PACKAGES / config_file).read_text())
     agg = Aggregator(build_analyzers(config["analyzers"], config["base_path"]))
     for item in KobukiBase().diagnostics("mobile_base_nodelet_manager"):
         agg.add(Status(item.level, item.name, item.message), 0.0)
