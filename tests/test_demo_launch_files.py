@@ -82,3 +82,12 @@ def test_demo_executables_are_executable_in_git():
     for line in out:
         mode, path = line.split()[0], line.split("\t")[1]
         assert mode in ("100755", "120000"), path
+
+
+@pytest.mark.parametrize("package", ["turtlesim", "tf", "learning_tf", "turtle_tf"])
+def test_demo_package_manifest_is_valid_format_2(package):
+    from catkin_pkg.package import parse_package
+
+    pkg = parse_package(str(REPO / "packages" / package / "package.xml"))
+    pkg.validate()
+    assert pkg.package_format == 2 and pkg.name == package
