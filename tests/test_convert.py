@@ -74,7 +74,8 @@ def yaml_ws(tmp_path_factory):
     shutil.copytree(WS, root, symlinks=True)
     for dirpath, _, _ in os.walk(root):
         os.chmod(dirpath, 0o755)  # the corpus is read-only; the copy must take new files
-    proc = run_cli("convert", str(root), "--to", "yaml")
+    env = dict(os.environ, ROS_PACKAGE_PATH=str(root))  # so $(find) names the copy
+    proc = run_cli("convert", str(root), "--to", "yaml", env=env)
     assert proc.returncode == 0, proc.stderr
     converted = {}
     for line in proc.stdout.splitlines():
@@ -125,6 +126,8 @@ def test_compat_case_converted_to_yaml_resolves_to_the_same_plan(case, yaml_ws, 
     assert from_yaml == from_xml
     loaded = json.loads(resolved(target, words, {}))["files_loaded"]
     assert loaded[0] == target
+    # includes were pointed at the converted files, even $(arg)-built ones: all YAML
+    assert [f for f in loaded if not f.endswith(".yaml")] == []
 
 
 @pytest.mark.parametrize("launch_file", [item["launch_file"] for item in SMOKE])
@@ -134,7 +137,11 @@ def test_smoke_file_converted_to_yaml_resolves_or_fails_the_same(launch_file, ya
     source = str(root / launch_file)
     target = convert.target_name(source, "yaml")
     assert target in converted
-    assert resolved(target, [], converted) == resolved(source, [], converted)
+    from_yaml = resolved(target, [], converted)
+    assert from_yaml == resolved(source, [], converted)
+    if not from_yaml.startswith("error"):
+        loaded = json.loads(resolved(target, [], {}))["files_loaded"]
+        assert [f for f in loaded if not f.endswith(".yaml")] == []
 
 
 # ---------------------------------------------------------------------- awkward strings
@@ -241,6 +248,32 @@ def test_cli_convert_directory_rewrites_includes_of_converted_files(tmp_path):
     assert (pkg / "inner.launch.yaml").is_file()
     assert not (tmp_path / "pkg" / "package.xml.yaml").exists()
     assert (pkg / "top.launch").is_file()  # sources are kept
+
+
+def test_directory_conversion_rewrites_arg_built_includes_only_when_all_candidates_convert(
+        tmp_path, monkeypatch):
+    ws = tmp_path / "ws"
+    for pkg in ("robot", "other"):
+        (ws / pkg / "launch" / "bases" / "a").mkdir(parents=True)
+        (ws / pkg / "package.xml").write_text(f"<package><name>{pkg}</name></package>\n")
+    launch = ws / "robot" / "launch"
+    (launch / "bases" / "a" / "base.launch.xml").write_text("<launch/>\n")
+    (launch / "common.launch").write_text("<launch/>\n")
+    (ws / "other" / "launch" / "common.launch").write_text("<launch/>\n")
+    (launch / "top.launch").write_text(
+        '<launch>\n'
+        '  <include file="$(find robot)/launch/bases/$(arg base)/base.launch.xml"/>\n'
+        '  <include file="$(find other)/launch/common.launch"/>\n'
+        '  <include file="$(dirname)/common.launch"/>\n'
+        '  <include file="$(arg anywhere)/common.launch"/>\n</launch>\n')
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(ws))
+    convert.convert_tree(str(ws / "robot"), "yaml")
+    top = yaml_frontend.parse_file(str(launch / "top.launch.yaml"))
+    assert [c.get("file") for c in top.children] == [
+        "$(find robot)/launch/bases/$(arg base)/base.launch.xml.yaml",  # every base converted
+        "$(find other)/launch/common.launch",   # same name, but outside the converted tree
+        "$(dirname)/common.launch.yaml",
+        "$(arg anywhere)/common.launch"]        # could be anywhere: left as written
 
 
 def test_directory_conversion_writes_nothing_when_one_file_is_bad(tmp_path):

@@ -13,7 +13,10 @@ moved over to YAML in one step; the original files are kept beside the new ones.
 """
 from __future__ import annotations
 
+import fnmatch
+import glob
 import os
+import re
 from dataclasses import dataclass
 
 import yaml as pyyaml
@@ -251,9 +254,9 @@ def is_launch_file(path: str, fmt_from: str) -> bool:
 def convert_tree(directory: str, fmt: str) -> list[Converted]:
     """Convert every launch file under ``directory`` to ``fmt``, writing each beside its source.
 
-    Include ``file=`` values whose last path component names a file converted in this run are
-    rewritten to the new name; others are left as written (the source files stay, and the
-    interpreter reads mixed trees, so they still resolve). Every file is parsed before any is
+    Includes that point at a file converted in this run are rewritten to the new name (see
+    ``_include_target``); others are left as written: the source files stay, and the
+    interpreter reads mixed trees, so they still resolve. Every file is parsed before any is
     written, so a bad file leaves the tree untouched.
     """
     fmt_from = "xml" if fmt == "yaml" else "yaml"
@@ -263,8 +266,8 @@ def convert_tree(directory: str, fmt: str) -> list[Converted]:
         for name in sorted(files):
             path = os.path.join(root, name)
             if is_launch_file(path, fmt_from):
-                sources.append(path)
-    renames = {os.path.basename(src): os.path.basename(target_name(src, fmt)) for src in sources}
+                sources.append(os.path.abspath(path))
+    converted = set(sources)
     results: list[tuple[str, str]] = []
     taken: dict[str, str] = {}
     for src in sources:
@@ -274,7 +277,7 @@ def convert_tree(directory: str, fmt: str) -> list[Converted]:
                                f"{target}", Location(src))
         taken[target] = src
         entity = load_entity(src)
-        _rewrite_includes(entity, renames)
+        _rewrite_includes(entity, src, converted, fmt)
         results.append((target, to_text(entity, fmt)))
     for target, text in results:
         with open(target, "w", encoding="utf-8") as fh:
@@ -282,13 +285,74 @@ def convert_tree(directory: str, fmt: str) -> list[Converted]:
     return [Converted(src, target) for src, (target, _) in zip(sources, results)]
 
 
-def _rewrite_includes(entity: Entity, renames: dict[str, str]) -> None:
+def _rewrite_includes(entity: Entity, source: str, converted: set[str], fmt: str) -> None:
     """Point ``<include file=...>`` at the converted file when it was converted too."""
     if entity.tag == "include":
         value = entity.get("file")
-        if value:
+        if value and _include_target(value, source, converted):
             head, sep, last = value.rpartition("/")
-            if last in renames:
-                entity.attributes["file"] = head + sep + renames[last]
+            entity.attributes["file"] = head + sep + os.path.basename(target_name(last, fmt))
     for child in entity.children:
-        _rewrite_includes(child, renames)
+        _rewrite_includes(child, source, converted, fmt)
+
+
+def _include_target(value: str, source: str, converted: set[str]) -> bool:
+    """Whether an include ``file=`` value certainly names a file converted in this run.
+
+    ``$(find pkg)`` (with the current package path) and ``$(dirname)`` are resolved; any
+    other substitution depends on args or the environment, unknown before launch, and stands
+    for "anything" (``$(find p)/launch/$(arg base)/mobile.launch.xml``). The value is
+    rewritten when every existing file it could name was converted (and there is one).
+    Otherwise it is left alone, which is always safe: the source it names is kept.
+    """
+    pattern = _static_pattern(value, source)
+    if pattern is None:
+        return False
+    if "*" not in pattern.replace("[*]", ""):
+        return os.path.normpath(value_path(pattern)) in converted
+    prefix = pattern.split("*", 1)[0]
+    base = prefix if prefix.endswith("/") else os.path.dirname(prefix)
+    if base in ("", "/") or "[" in base:
+        return False
+    matches = []
+    for root, _, files in os.walk(base):
+        for name in files:
+            path = os.path.join(root, name)
+            if fnmatch.fnmatchcase(path, pattern):
+                matches.append(path)
+    return bool(matches) and all(path in converted for path in matches)
+
+
+def value_path(pattern: str) -> str:
+    """The plain path of a pattern that has no wildcard (undo ``glob.escape``)."""
+    return re.sub(r"\[(.)\]", r"\1", pattern)
+
+
+def _static_pattern(value: str, source: str) -> str | None:
+    """``value`` as an absolute fnmatch pattern: ``$(dirname)`` and ``$(find pkg)`` resolved,
+    other substitutions as ``*``; None when a package is unknown or the path is relative."""
+    from orchestra.launch import substitution
+    from orchestra.packages import PackageNotFound, find_package
+
+    hole = "\0"
+    try:
+        bodies = substitution.collect(value)
+    except OrchestraError:
+        return None
+    result = value
+    for body in bodies:
+        token = f"$({body})"
+        words = body.split()
+        if words == ["dirname"]:
+            result = result.replace(token, os.path.dirname(source))
+        elif len(words) == 2 and words[0] == "find" and "$" not in words[1]:
+            try:
+                result = result.replace(token, find_package(words[1]))
+            except PackageNotFound:
+                return None
+        else:
+            result = result.replace(token, hole)
+    if not os.path.isabs(result):
+        return None
+    result = os.path.normpath(result)
+    return glob.escape(result).replace(hole, "*")
