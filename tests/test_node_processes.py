@@ -284,3 +284,36 @@ def test_slave_api_reports_pid_publications_subscriptions_and_bus_info(nodes, ma
     assert len(rows) == 1 and rows[0][2] == "i"
     assert api.shutdown("/test", "bye")[0] == 1
     assert pub.wait() == 0
+
+
+def test_publisher_counts_subscribers_as_they_come_and_go(nodes):
+    pub = nodes.start("pub.py", "counted", "std_msgs/String", "data: x", "--report",
+                      "--rate", "5")
+    pub.ready()
+    sub = nodes.start("sub.py", "counted", "std_msgs/String")
+    sub.ready()
+    pub.expect(lambda d: d.get("connections") == 1)
+    sub.signal(signal.SIGTERM)
+    assert sub.wait() == 0
+    pub.expect(lambda d: d.get("connections") == 0)
+
+
+def test_node_started_before_the_master_waits_for_it(package_path):
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    group = Nodes(f"http://127.0.0.1:{port}/", package_path)
+    try:
+        sub = group.start("sub.py", "early", "std_msgs/String")
+        time.sleep(1.0)
+        assert sub.proc.poll() is None
+        handle = start_master(host="127.0.0.1", port=port)
+        try:
+            assert sub.ready()["topic"] == "/early"
+            group.start("pub.py", "early", "std_msgs/String", "data: late master").ready()
+            assert sub.messages() == {"data": "late master"}
+        finally:
+            group.close()
+            handle.shutdown()
+    finally:
+        group.close()

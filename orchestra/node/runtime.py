@@ -164,20 +164,24 @@ class NodeRuntime:
 
     # master registration ------------------------------------------------------------------
     def master_register(self, method: str, name: str, type_: str) -> Any:
-        """Register with the master, retrying while it is not up yet (as rospy does)."""
+        """Register with the master, waiting for it to come up (as rospy does)."""
+        return self.master_retry(method, name, type_, self.uri)
+
+    def master_retry(self, method: str, *args: Any) -> Any:
+        """A master call that waits for the master to come up (used during start-up)."""
         delay = 0.1
-        warned = False
         while True:
             try:
-                return self.master.call(method, name, type_, self.uri)
+                return self.master.call(method, *args)
             except MasterError as exc:
                 if exc.code is not None:
-                    raise ROSException(f"{method} {name}: {exc}") from exc
+                    raise ROSException(f"{method}: {exc}") from exc
                 if self.is_shutdown():
-                    raise ROSInterruptException("shutdown while registering") from exc
-                if not warned:
-                    log.warning("cannot reach the master at %s, will keep trying", self.master_uri)
-                    warned = True
+                    raise ROSInterruptException(
+                        f"shutdown while waiting for the master ({method})") from exc
+                if delay == 0.1:
+                    log.warning("cannot reach the master at %s, will keep trying",
+                                self.master_uri)
                 self._shutdown_requested.wait(delay)
                 delay = min(delay * 2, 2.0)
 
@@ -195,8 +199,8 @@ class NodeRuntime:
             self.services[server.name] = server
         host, port = self.tcpros_address
         try:
-            self.master.call("registerService", server.name, f"rosrpc://{host}:{port}", self.uri)
-        except MasterError as exc:
+            self.master_retry("registerService", server.name, f"rosrpc://{host}:{port}", self.uri)
+        except ROSException as exc:
             with self._services_lock:
                 self.services.pop(server.name, None)
             raise ROSException(f"cannot register service {server.name}: {exc}") from exc
@@ -330,19 +334,28 @@ def init_node(name: str, argv: list[str] | None = None, anonymous: bool = False,
     atexit.register(_at_exit)
     if not disable_signals and threading.current_thread() is threading.main_thread():
         for sig in (signal.SIGINT, signal.SIGTERM):
-            signal.signal(sig, _on_signal)
+            _previous_handlers[sig] = signal.signal(sig, _on_signal)
     for key, text in parsed.private_params.items():
         try:
             value = yaml.safe_load(text) if text != "" else ""
         except yaml.YAMLError:
             value = text
-        set_param("~" + key, value)
+        runtime.master_retry("setParam", runtime.resolve_name("~" + key), value)
     if not disable_rosout:
         runtime.rosout = _make_rosout()
 
 
+_previous_handlers: dict[int, Any] = {}
+
+
 def _on_signal(signum, frame) -> None:
+    """First signal: orderly shutdown (``is_shutdown()`` turns true, sleeps raise). A second
+    SIGINT goes to the previous handler (KeyboardInterrupt), for scripts that never look."""
+    already = is_shutdown()
     signal_shutdown(f"signal {signal.Signals(signum).name}")
+    previous = _previous_handlers.get(signum)
+    if already and signum == signal.SIGINT and callable(previous):
+        previous(signum, frame)
 
 
 def _at_exit() -> None:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import collections
 import logging
+import select
 import socket
 import threading
 import time
@@ -84,6 +85,20 @@ class OutConnection:
             self.bytes_sent += len(data) + 4
             self.messages_sent += 1
 
+    def peer_closed(self) -> bool:
+        """Whether the subscriber hung up. Subscribers send nothing after their header, so a
+        readable socket means end of stream; checked when someone counts connections,
+        since an idle writer would otherwise only notice at the next publish."""
+        if self.closed:
+            return True
+        try:
+            readable, _, _ = select.select([self.sock], [], [], 0)
+            if readable and self.sock.recv(1, socket.MSG_PEEK | socket.MSG_DONTWAIT) == b"":
+                return True
+        except (OSError, ValueError):
+            return True
+        return False
+
     def close(self) -> None:
         with self.cond:
             self.closed = True
@@ -150,7 +165,15 @@ class Publication:
                 self.connections.remove(conn)
         conn.close()
 
+    def prune(self) -> None:
+        """Drop connections whose subscriber has gone away."""
+        with self.lock:
+            dead = [c for c in self.connections if c.peer_closed()]
+        for conn in dead:
+            self.remove_connection(conn)
+
     def num_connections(self) -> int:
+        self.prune()
         with self.lock:
             return len(self.connections)
 
@@ -532,6 +555,8 @@ class TopicManager:
 
     def bus_stats(self) -> tuple[list, list]:
         pubs, subs = [], []
+        for pub in list(self.publications.values()):
+            pub.prune()
         with self.lock:
             for topic, pub in self.publications.items():
                 conns = [[c.id, c.bytes_sent, c.messages_sent, not c.closed]
@@ -545,6 +570,8 @@ class TopicManager:
 
     def bus_info(self) -> list:
         info = []
+        for pub in list(self.publications.values()):
+            pub.prune()
         with self.lock:
             for topic, pub in self.publications.items():
                 for c in list(pub.connections):
