@@ -7,6 +7,7 @@ exports; CMakeLists.txt has the same non-comment lines.
 from __future__ import annotations
 
 import os
+import shutil
 import stat
 import subprocess
 import sys
@@ -18,8 +19,10 @@ from orchestra.packages.cli import parse_create_args
 from orchestra.packages.create import InvalidPackageRequest, PackageRequest, create_package
 from orchestra.packages.manifest import parse_manifest
 
-#: the real tool, run from the installed catkin_pkg (a test dependency) with this interpreter
-CATKIN_CREATE_PKG = [sys.executable, "-m", "catkin_pkg.cli.create_pkg"]
+#: the real tool: the catkin_create_pkg script catkin_pkg (a test dependency) installs, or the
+#: same entry point run with this interpreter when the script is not on PATH
+CATKIN_CREATE_PKG = ([shutil.which("catkin_create_pkg")] if shutil.which("catkin_create_pkg")
+                     else [sys.executable, "-m", "catkin_pkg.cli.create_pkg"])
 ORCHESTRA = [sys.executable, "-m", "orchestra"]
 ENV = {**os.environ, "ROS_DISTRO": "noetic", "USER": "tester", "LOGNAME": "tester"}
 
