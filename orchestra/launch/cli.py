@@ -155,8 +155,11 @@ def launch(words: tuple[str, ...], dump_plan: bool, dump_params: bool, nodes: bo
     if ros_args:
         click.echo(_ros_args(paths, args))
         return
-    # like roslaunch, everything but the two dumps loads roscore.xml's params first
-    interp = _interpret(paths, args, no_exec=no_exec, roscore=not (dump_plan or dump_params))
+    dumping = dump_plan or dump_params or nodes or bool(node_args) or files or bool(find_node)
+    # like roslaunch, everything but the two dumps loads roscore.xml's params first; when the
+    # plan is going to run, command= params always run (--no-exec only shapes the dumps)
+    interp = _interpret(paths, args, no_exec=no_exec and dumping,
+                        roscore=not (dump_plan or dump_params))
     plan = interp.plan()
     if dump_plan:
         click.echo(_dump_json(plan))
