@@ -310,3 +310,17 @@ def test_compat_cases_have_no_errors_but_missing_node_packages(compat_dir, monke
             report = check_files([str(compat_dir / "ws" / case["launch_file"])], args)
         false_alarms += [str(p) for p in report.errors if p.code != "missing-package"]
     assert false_alarms == []
+
+
+def test_cli_directory_checks_included_files_through_their_includer(ws):
+    write(ws / "launch", "inner.launch", '<launch>\n  <arg name="rate"/>\n'
+          '  <param name="p" value="$(arg rate)"/>\n</launch>\n')
+    write(ws / "launch", "top.launch", '<launch>\n  <include file="$(dirname)/inner.launch">\n'
+          '    <arg name="rate" value="5"/>\n  </include>\n</launch>\n')
+    write(ws / "launch", "broken.launch", '<launch>\n  <nod/>\n</launch>\n')
+    proc = run_cli(str(ws), env=dict(os.environ))
+    assert proc.returncode == 1
+    # inner.launch on its own would miss 'rate'; through top.launch it is fine
+    assert [line.split(":")[0] for line in proc.stdout.splitlines()] == \
+        [str(ws / "launch" / "broken.launch")]
+    assert "2 file(s) checked" in proc.stderr

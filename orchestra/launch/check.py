@@ -685,3 +685,15 @@ def check_files(paths: list[str], cli_args: dict[str, str] | None = None) -> Rep
     for path in paths:
         checker.check(path)
     return checker.report
+
+
+def check_tree(paths: list[str], cli_args: dict[str, str] | None = None) -> Report:
+    """Check a set of files such as a package's launch directory: files that another file of
+    the set includes are checked through that include (with the args it passes), not on
+    their own, where their required args would look missing."""
+    probe = Checker(cli_args)
+    for path in paths:
+        probe._check_file(os.path.abspath(path), dict(probe.cli_args), top=True)
+    included = {target for _, target in probe.graph.edges}
+    roots = [path for path in paths if os.path.abspath(path) not in included]
+    return check_files(roots or paths, cli_args)

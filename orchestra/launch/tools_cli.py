@@ -44,35 +44,46 @@ def convert(path: str, fmt: str, output: str | None) -> None:
         sys.stdout.write(text)
 
 
-def _split_words(words: tuple[str, ...]) -> tuple[list[str], dict[str, str]]:
-    """Files and ``name:=value`` args, in any order (roslaunch's command-line convention)."""
+def _expand(paths: list[str]) -> list[str]:
+    """Files as given; a directory stands for every launch file (XML or YAML) under it."""
     files: list[str] = []
-    args: dict[str, str] = {}
-    for word in words:
-        if ":=" in word:
-            name, _, value = word.partition(":=")
-            args[name] = value
-        else:
-            files.append(word)
-    return files, args
+    for path in paths:
+        if not os.path.isdir(path):
+            files.append(path)
+            continue
+        for root, dirs, names in os.walk(path):
+            dirs.sort()
+            for name in sorted(names):
+                candidate = os.path.join(root, name)
+                if conversion.is_launch_file(candidate, "xml") or \
+                        conversion.is_launch_file(candidate, "yaml"):
+                    files.append(candidate)
+    return files
 
 
 @click.command()
-@click.argument("words", nargs=-1, required=True, metavar="FILE... [name:=value ...]")
+@click.argument("words", nargs=-1, required=True, metavar="FILE|DIR... [name:=value ...]")
 @click.option("--strict", is_flag=True, help="Warnings fail the check too.")
 @click.pass_context
 def check(ctx: click.Context, words: tuple[str, ...], strict: bool) -> None:
     """Report every problem in launch files (and what they include), starting nothing.
 
+    A DIR stands for every launch file under it. Args apply to every file checked.
+
     Each line is FILE:LINE:COLUMN: error|warning: message [code]. Exit status: 0 when no
     errors were found (warnings allowed unless --strict), 1 otherwise.
     """
-    from orchestra.launch.check import check_files
+    from orchestra.launch.check import check_files, check_tree
+    from orchestra.names import load_mappings
 
-    files, args = _split_words(words)
-    if not files:
-        raise click.UsageError("give at least one launch file")
-    report = check_files(files, args)
+    paths = [w for w in words if ":=" not in w]
+    args = load_mappings([w for w in words if ":=" in w])
+    if not paths:
+        raise click.UsageError("give at least one launch file or directory")
+    if any(os.path.isdir(path) for path in paths):
+        report = check_tree(_expand(paths), args)
+    else:
+        report = check_files(paths, args)
     for problem in report.sorted():
         click.echo(str(problem))
     errors, warnings = len(report.errors), len(report.warnings)
