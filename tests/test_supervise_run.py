@@ -288,3 +288,45 @@ def test_orchestra_status_without_launch_says_so(tmp_path):
     cli = subprocess.run([sys.executable, "-m", "orchestra", "status"], env=env,
                          capture_output=True, text=True)
     assert cli.returncode == 1 and "no running orchestra launch" in cli.stderr
+
+
+def test_launch_registers_its_xmlrpc_uri_on_the_master_like_roslaunch(run_env, monkeypatch):
+    import signal
+    import xmlrpc.client
+
+    monkeypatch.setenv("PROBE_MODE_idle", "sleep")
+    master = xmlrpc.client.ServerProxy(os.environ["ROS_MASTER_URI"])
+    seen: dict = {}
+
+    def inspect() -> None:
+        try:
+            deadline = time.monotonic() + 20
+            while not (run_env["out"] / "idle.json").exists() and time.monotonic() < deadline:
+                time.sleep(0.02)
+            code, _, uris = master.getParam("/t", "/roslaunch/uris")
+            seen["uris"] = uris
+            launch = xmlrpc.client.ServerProxy(list(uris.values())[0])
+            seen["pid"] = launch.getPid("/t")[2]
+            seen["processes"] = launch.list_processes("/t")[2]
+            cli = subprocess.run([sys.executable, "-m", "orchestra", "status", "--master",
+                                  "--json"], capture_output=True, text=True)
+            seen["cli"] = json.loads(cli.stdout)
+        finally:
+            os.kill(os.getpid(), signal.SIGTERM)
+
+    thread = threading.Thread(target=inspect)
+    thread.start()
+    try:
+        assert run_plan(LaunchPlan(nodes=(Node("demo", "probe", "idle"),)), OPTS) == 0
+    finally:
+        thread.join()
+    (key, uri), = seen["uris"].items()
+    assert key.startswith("host_localhost__") and uri.startswith("http://localhost:")
+    assert key.endswith("__" + uri.rsplit(":", 1)[1].rstrip("/"))
+    assert seen["pid"] == os.getpid()
+    assert seen["processes"] == [["/idle"], []]
+    assert [n["name"] for n in seen["cli"][0]["nodes"]] == ["/idle"]
+    assert seen["cli"][0]["run_id"] == "testrun"
+    # gone from the master when the launch ends (roslaunch leaves stale entries)
+    code, _, after = master.getParam("/t", "/roslaunch/uris")
+    assert code != 1 or key not in after

@@ -73,15 +73,29 @@ def run_plan(plan: Any, options: dict[str, Any]) -> int:
 @click.option("--json", "as_json", is_flag=True, help="Print the snapshot(s) as JSON.")
 @click.option("--socket", "socket_path", default=None, type=click.Path(),
               help="Ask only the launch behind this status socket.")
-def status(as_json: bool, socket_path: str | None) -> int:
-    """Show the nodes of the running launches: state, pid, restarts, uptime, CPU%, RSS."""
-    from orchestra.supervise.status import query, running_launches, table_lines
+@click.option("--master", "use_master", is_flag=True,
+              help="Ask the launches registered on the master at ROS_MASTER_URI "
+                   "(/roslaunch/uris), also those of other users and machines.")
+def status(as_json: bool, socket_path: str | None, use_master: bool) -> int:
+    """Show the nodes of the running launches: state, pid, restarts, uptime, CPU%, RSS.
+
+    By default every launch of this user on this machine answers over its local socket.
+    """
+    from orchestra.supervise.status import (launches_on_master, query, running_launches,
+                                            table_lines)
 
     if socket_path:
         try:
             launches = [query(socket_path)]
         except OSError as exc:
             raise click.ClickException(f"no launch answers at {socket_path}: {exc}") from None
+    elif use_master:
+        from orchestra.master import master_uri_from_env
+
+        try:
+            launches = launches_on_master(master_uri_from_env())
+        except OSError as exc:
+            raise click.ClickException(str(exc)) from None
     else:
         launches = running_launches()
     if as_json:

@@ -212,7 +212,9 @@ class MasterConnection:
 
 def _existing_run_id(uri: str) -> str | None:
     try:
-        code, _, value = xmlrpc.client.ServerProxy(uri).getParam("/roslaunch", "/run_id")
+        from orchestra.master.client import proxy
+
+        code, _, value = proxy(uri, timeout=5.0).getParam("/roslaunch", "/run_id")
     except Exception:  # noqa: BLE001 - a master without /run_id is fine
         return None
     return value if code == 1 and isinstance(value, str) else None
@@ -253,6 +255,29 @@ def upload(plan: LaunchPlan, master: MasterConnection) -> None:
     upload_params(master.uri, params, list(plan.clear_params))
 
 
+def _is_loopback_uri(uri: str) -> bool:
+    host = urllib.parse.urlsplit(uri).hostname or "localhost"
+    return host in LOCAL_NAMES or host.startswith("127.")
+
+
+def _set_param(uri: str, key: str, value: Any) -> None:
+    try:
+        from orchestra.master.client import proxy
+
+        proxy(uri, timeout=5.0).setParam("/roslaunch", key, value)
+    except Exception as exc:  # noqa: BLE001 - the launch runs without this entry
+        logger.warning("cannot set %s on the master: %s", key, exc)
+
+
+def _delete_param(uri: str, key: str) -> None:
+    try:
+        from orchestra.master.client import proxy
+
+        proxy(uri, timeout=5.0).deleteParam("/roslaunch", key)
+    except Exception as exc:  # noqa: BLE001 - master may be gone already
+        logger.debug("cannot delete %s: %s", key, exc)
+
+
 def _set_title(title: str) -> None:
     if sys.stdout.isatty():
         sys.stdout.write(f"\x1b]2;{title}\x07")
@@ -262,6 +287,7 @@ def _set_title(title: str) -> None:
 def run_plan(plan: LaunchPlan, options: Mapping[str, Any]) -> int:
     """Run the plan's nodes under supervision until stopped; returns orchestra's exit code."""
     from orchestra.supervise.reaper import Watchdog
+    from orchestra.supervise.rpc import LaunchRPCServer, uris_param
     from orchestra.supervise.status import LiveView, ProcessStats, StatusServer, snapshot
     from orchestra.supervise.supervisor import Supervisor
 
@@ -298,6 +324,10 @@ def run_plan(plan: LaunchPlan, options: Mapping[str, Any]) -> int:
             return snapshot(supervisor.procs, stats, info)
 
         server = StatusServer(supervisor.loop, make_snapshot)
+        rpc = LaunchRPCServer(supervisor.loop, supervisor.procs, make_snapshot,
+                              loopback=_is_loopback_uri(master.uri))
+        uris_key = uris_param(rpc.host, rpc.port)
+        _set_param(master.uri, uris_key, rpc.uri)
         view_on = opts.status_view if opts.status_view is not None else screen.out.isatty()
         view = LiveView(supervisor.loop, screen, make_snapshot) if view_on else None
         if view is not None:
@@ -309,6 +339,9 @@ def run_plan(plan: LaunchPlan, options: Mapping[str, Any]) -> int:
             if view is not None:
                 view.close()
             server.close()
+            rpc.close()
+            if master.handle is None:       # roslaunch leaves it behind; we do not
+                _delete_param(master.uri, uris_key)
     finally:
         if master is not None:
             master.close()

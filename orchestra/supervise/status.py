@@ -207,6 +207,32 @@ def running_launches(directory: str | None = None) -> list[dict[str, Any]]:
     return found
 
 
+def launches_on_master(master_uri: str, timeout: float = 3.0) -> list[dict[str, Any]]:
+    """Snapshots of the orchestra launches registered under /roslaunch/uris on a master.
+
+    Entries of real roslaunch processes (no ``orchestra_status``) and dead ones are skipped.
+    """
+    import xmlrpc.client
+
+    from orchestra.master.client import proxy
+
+    try:
+        code, _, uris = proxy(master_uri, timeout).getParam("/orchestra_status", "/roslaunch/uris")
+    except (OSError, xmlrpc.client.Error):
+        raise OSError(f"no master answers at {master_uri}") from None
+    if code != 1 or not isinstance(uris, dict):
+        return []
+    found = []
+    for key in sorted(uris):
+        try:
+            code, _, doc = proxy(str(uris[key]), timeout).orchestra_status("/orchestra_status")
+            if code == 1:
+                found.append(json.loads(doc))
+        except (OSError, xmlrpc.client.Error, ValueError):
+            continue
+    return found
+
+
 class LiveView:
     """Redraws the status table under the scrolling node output on a TTY, once a second."""
 
