@@ -110,7 +110,8 @@ def _fresh(directory: str, record: Record | None, mtime_ns: int) -> bool:
         return False
     if record[1] == "pkg":
         try:
-            return os.stat(os.path.join(directory, record[3])).st_mtime_ns == record[4] >= 0
+            # plain concatenation: os.path.join dominated warm crawls in profiles
+            return os.stat(directory + os.sep + record[3]).st_mtime_ns == record[4] >= 0
         except OSError:
             return False
     return True
@@ -147,7 +148,8 @@ def crawl(root: str, previous: dict[str, Record] | None = None) -> CrawlResult:
         if record[1] == "pkg":
             result.packages.append((record[2], directory))
         elif record[1] == "dir":
-            stack.extend(os.path.join(directory, child) for child in reversed(record[2]))
+            prefix = directory if directory.endswith(os.sep) else directory + os.sep
+            stack.extend([prefix + child for child in reversed(record[2])])
     if not result.changed and len(result.records) != len(previous):
         result.changed = True
     return result
