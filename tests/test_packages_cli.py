@@ -108,6 +108,8 @@ def test_pkg_find_and_list_and_duplicates(env, tmp_path):
     proc = cli("pkg", "list", cwd=tmp_path, env_extra=extra)
     assert f"alpha {env / 'alpha'}" in proc.stdout.splitlines()
     assert f"beta {other / 'beta'}" in proc.stdout.splitlines()
+    proc = cli("pkg", "list", "--origins", cwd=tmp_path, env_extra=extra)
+    assert f"beta {other / 'beta'} [ROS_PACKAGE_PATH]" in proc.stdout.splitlines()
     proc = cli("pkg", "list", "--duplicates", cwd=tmp_path, env_extra=extra)
     assert proc.stdout.splitlines() == [f"alpha {env / 'alpha'}", f"alpha {other / 'alpha'} (shadowed)"]
 

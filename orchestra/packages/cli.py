@@ -22,7 +22,9 @@ def pkg() -> None:
 @click.option("--duplicates", is_flag=True,
               help="Only packages found more than once: the winner, then the shadowed copies.")
 @click.option("-n", "--names-only", is_flag=True, help="Print names only.")
-def list_cmd(duplicates: bool, names_only: bool) -> None:
+@click.option("--origins", is_flag=True,
+              help="Also say which search root each package came from.")
+def list_cmd(duplicates: bool, names_only: bool, origins: bool) -> None:
     """Every package on the search path, with its directory."""
     from orchestra.packages.index import get_index
 
@@ -34,7 +36,12 @@ def list_cmd(duplicates: bool, names_only: bool) -> None:
                 click.echo(f"{name} {shadowed} (shadowed)")
         return
     for name in index.names():
-        click.echo(name if names_only else f"{name} {index.packages[name]}")
+        if names_only:
+            click.echo(name)
+        elif origins:
+            click.echo(f"{name} {index.packages[name]} [{index.origins[name].origin}]")
+        else:
+            click.echo(f"{name} {index.packages[name]}")
 
 
 @pkg.command("find")

@@ -46,7 +46,7 @@ class PackageIndex:
     packages: dict[str, str] = field(default_factory=dict)
     duplicates: dict[str, list[str]] = field(default_factory=dict)
     roots: list[SearchRoot] = field(default_factory=list)
-    #: package name -> the search root it was found under (for ``pkg list --verbose``)
+    #: package name -> the search root it was found under (``pkg list --origins``)
     origins: dict[str, SearchRoot] = field(default_factory=dict)
     #: directories that had to be listed while building (0 = everything came from the cache)
     listed: int = 0
