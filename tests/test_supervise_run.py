@@ -330,3 +330,14 @@ def test_launch_registers_its_xmlrpc_uri_on_the_master_like_roslaunch(run_env, m
     # gone from the master when the launch ends (roslaunch leaves stale entries)
     code, _, after = master.getParam("/t", "/roslaunch/uris")
     assert code != 1 or key not in after
+
+
+def test_test_nodes_run_only_in_test_mode(run_env):
+    from orchestra.launch.plan import Test
+
+    plan = LaunchPlan(nodes=(Node("demo", "probe", "plain"),),
+                      tests=(Test("demo", "probe", "checker", test_name="t"),))
+    assert run_plan(plan, OPTS) == 0
+    assert not (run_env["out"] / "checker.json").exists()
+    assert run_plan(plan, dict(OPTS, with_tests=True)) == 0
+    assert (run_env["out"] / "checker.json").exists()
