@@ -173,3 +173,14 @@ def test_rejections_name_file_line_and_attribute(write, text, attr):
 def test_duplicate_node_names_are_rejected(write):
     with pytest.raises(OrchestraError, match="duplicate node name"):
         launch(write, '<node name="n" pkg="p" type="t"/><node name="n" pkg="q" type="t"/>')
+
+
+@pytest.mark.parametrize("text, attr", [
+    ('<group ns="~x"/>', "ns"),
+    ('<node name="~a" pkg="p" type="t"/>', "name"),
+    ('<param name="y" type="yaml" value="[1, 2"/>', "value"),
+])
+def test_private_namespaces_and_bad_yaml_values_are_located_errors(write, text, attr):
+    with pytest.raises(OrchestraError) as info:
+        launch(write, "\n" + text)
+    assert "main.launch:2" in str(info.value) and attr in str(info.value)

@@ -87,3 +87,9 @@ def test_eval_sandbox_refuses_escapes(expr):
 def test_eval_only_applies_to_a_whole_value():
     with pytest.raises(SubstitutionError):
         resolve("x $(eval 1 + 1)", Scope())
+
+
+def test_eval_refuses_runaway_exponents():
+    with pytest.raises(SubstitutionError, match="exponent"):
+        resolve("$(eval 10**10**10)", Scope())
+    assert resolve("$(eval 2**10)", Scope()) == "1024"

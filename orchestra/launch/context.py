@@ -67,9 +67,9 @@ class Scope:
                 child_ns = ns_join(self.ns, ns)
         else:
             child_ns = self.ns
-        if child_ns == PRIVATE:
-            # roslaunch would fail later on a '~' namespace; keep a usable global one
-            child_ns = self.ns
+        if child_ns.startswith(PRIVATE):
+            raise ScopeError(f"namespace [{child_ns}] is private: a namespace must be "
+                             "relative or global")
         return Scope(child_ns, self.filename, parent=self, params=self.params,
                      env_args=list(self.env_args), args=dict(self.args),
                      arg_names=list(self.arg_names),

@@ -224,10 +224,13 @@ class Interpreter:
             ns = self._resolve(entity, "ns", scope)
             if not ns:
                 raise self._error(entity, "empty namespace", "ns")
-        if include_file is not None:
-            child = scope.include_child(ns, include_file)
-        else:
-            child = scope.child(ns)
+        try:
+            if include_file is not None:
+                child = scope.include_child(ns, include_file)
+            else:
+                child = scope.child(ns)
+        except ScopeError as exc:
+            raise self._error(entity, str(exc), "ns") from None
         clear = self._resolve(entity, "clear_params", scope)
         if clear:
             try:
@@ -383,6 +386,8 @@ class Interpreter:
                      ) -> Any:
         try:
             if source == "value":
+                if ptype == "yaml":
+                    return self._yaml_value(entity, raw.strip())
                 return convert_value(raw.strip(), ptype)
             if source == "textfile":
                 try:
@@ -406,6 +411,13 @@ class Interpreter:
             raise
         except ValueError as exc:
             raise self._error(entity, str(exc), "type" if ptype != "auto" else source) from None
+
+    def _yaml_value(self, entity: Entity, text: str) -> Any:
+        from orchestra.params.yaml import RosparamYamlError, load_yaml_value
+        try:
+            return load_yaml_value(text, entity.location.file)
+        except RosparamYamlError as exc:
+            raise self._error(entity, exc.message, "value") from None
 
     def _run_command(self, entity: Entity, name: str, command: str) -> str:
         """roslaunch runs ``command=`` at load time, shell-split but without a shell."""
@@ -544,7 +556,10 @@ class Interpreter:
         if not is_legal_name(name):
             self._warn(entity, f"illegal node name '{name}'")
         child = self._ns_and_clear_params(entity, scope, node_name=name)
-        param_scope = child.child(name)
+        try:
+            param_scope = child.child(name)
+        except ScopeError as exc:
+            raise self._error(entity, str(exc), "name") from None
         param_scope.params = []
         pkg, node_type = self._req(entity, scope, "pkg", "type")
         machine, args, output, respawn, respawn_delay, cwd, launch_prefix, required = \

@@ -190,6 +190,7 @@ _SAFE_BUILTINS: dict[str, Any] = {
                  "round", "set", "sorted", "str", "sum", "tuple", "zip")
 }
 _FORBIDDEN_ATTRS = {"format", "format_map", "mro"}
+_MAX_EXPONENT = 64
 
 
 def _check_expression(expr: str) -> ast.Expression:
@@ -205,6 +206,12 @@ def _check_expression(expr: str) -> ast.Expression:
             raise SubstitutionError(f"$(eval ...) may not use the attribute '{node.attr}'")
         if isinstance(node, (ast.Lambda, ast.NamedExpr)):
             raise SubstitutionError("$(eval ...) may not define functions or assign")
+        if isinstance(node, ast.BinOp) and isinstance(node.op, ast.Pow):
+            exponent = node.right
+            if not (isinstance(exponent, ast.Constant) and isinstance(exponent.value, (int, float))
+                    and abs(exponent.value) <= _MAX_EXPONENT):
+                raise SubstitutionError("$(eval ...) exponents must be literal numbers up to "
+                                        f"{_MAX_EXPONENT} (no runaway computations)")
     return tree
 
 
