@@ -184,3 +184,21 @@ def test_private_namespaces_and_bad_yaml_values_are_located_errors(write, text, 
     with pytest.raises(OrchestraError) as info:
         launch(write, "\n" + text)
     assert "main.launch:2" in str(info.value) and attr in str(info.value)
+
+
+def test_yaml_launch_file_uses_the_same_rules_and_can_include_xml(write):
+    write("inc.launch", '<launch><arg name="who"/><node name="x" pkg="p" type="t" '
+                        'args="$(arg who)"/></launch>')
+    path = write("main.launch.yaml", "launch:\n"
+                 "  - arg: {name: rate, default: '10'}\n"
+                 "  - group:\n"
+                 "      ns: g\n"
+                 "      children:\n"
+                 "        - param: {name: rate, value: $(arg rate)}\n"
+                 "        - include:\n"
+                 "            file: $(dirname)/inc.launch\n"
+                 "            children: [{arg: {name: who, value: me}}]\n")
+    plan = load_launch(path, {"rate": "5"})
+    assert plan.params == {"/g/rate": 5}
+    assert [(n.full_name, n.args) for n in plan.nodes] == [("/g/x", "me")]
+    assert plan.files_loaded == (path, path.replace("main.launch.yaml", "inc.launch"))
