@@ -26,6 +26,7 @@ import os
 import shutil
 import signal
 import subprocess
+import warnings
 from typing import Callable, Iterable, Mapping
 
 import psutil
@@ -126,7 +127,11 @@ class Watchdog:
 
     def __init__(self) -> None:
         read_fd, write_fd = os.pipe()
-        pid = os.fork()
+        with warnings.catch_warnings():
+            # Python >= 3.12 warns about fork() with threads running (an embedded master in
+            # tests); the child only makes raw system calls, which is fork-safe
+            warnings.simplefilter("ignore", DeprecationWarning)
+            pid = os.fork()
         if pid == 0:  # child
             try:
                 os.close(write_fd)
