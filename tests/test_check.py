@@ -9,7 +9,6 @@ from pathlib import Path
 
 import pytest
 
-from conftest import COMPAT
 from orchestra.launch.check import ERROR, WARNING, check_files
 
 
@@ -170,6 +169,14 @@ def test_duplicate_node_names_are_reported_from_the_resolved_plan(ws):
     [problem] = report.errors
     assert "duplicate node name [/g/n]" in problem.message
     assert problem.location.line == 5
+
+
+def test_duplicate_test_names_are_reported_too(ws):
+    path = write(ws / "launch", "a.test",
+                 '<launch>\n  <test test-name="t" pkg="mypkg" type="x"/>\n'
+                 '  <test test-name="t" pkg="mypkg" type="y"/>\n</launch>\n')
+    problem = only(check_files([path]), "duplicate-node")
+    assert problem.location.line == 3 and "/t" in problem.message
 
 
 def test_respawn_with_required_is_an_error(ws):

@@ -20,6 +20,7 @@ false) are downgraded to warnings: they are real, but they do not break this lau
 from __future__ import annotations
 
 import ast
+import builtins
 import difflib
 import logging
 import os
@@ -77,9 +78,7 @@ def _tag_rules() -> tuple[dict[str, frozenset[str]], dict[str, tuple[str, ...]]]
 
 # Names an ``$(eval ...)`` expression may use that are not args.
 _EVAL_NAMES = frozenset({"arg", "env", "optenv", "find", "anon", "dirname", "true", "false",
-                         "True", "False", "None"}) | frozenset(dir(__builtins__)
-                                                                if isinstance(__builtins__, dict)
-                                                                else vars(__builtins__))
+                         "True", "False", "None"}) | frozenset(dir(builtins))
 
 
 @dataclass(frozen=True)
@@ -615,8 +614,8 @@ class Checker:
         return where
 
     def _check_plan(self, plan: Any) -> None:
-        """What only a resolved plan shows and the interpreter allows (nothing, today:
-        it rejects duplicate node names itself; kept for unnamed-test collisions)."""
+        """What only a resolved plan shows and the interpreter lets through: two ``<test>``s
+        (or a test and a node) with the same full name (it rejects duplicate nodes itself)."""
         seen: dict[str, Any] = {}
         for node in (*plan.nodes, *plan.tests):
             if node.full_name in seen:
