@@ -106,3 +106,34 @@ def test_turtlesim_node_services_topics_walls_and_snapshots(master, tmp_path):
     _, _, reset = read_png((tmp_path / "reset.png").read_bytes())
     assert tuple(reset[0:3]) == (0, 0, 0)  # cleared with the new background params
     assert tuple(reset[i:i + 3]) == (0, 0, 0)  # and the old trail is gone
+
+
+READ_POSE = r'''
+import orchestra.node as node
+from orchestra.node.msg import get_message_class
+node.init_node("gui_test_reader", anonymous=True)
+m = node.wait_for_message("/turtle1/pose", get_message_class("turtlesim/Pose"), timeout=20)
+print(m.x)
+'''
+
+
+@pytest.mark.timeout(60)
+def test_gui_requested_on_an_unusable_display_falls_back_to_headless(master):
+    env = dict(os.environ, ROS_MASTER_URI=master, DISPLAY=":987", PYTHONUNBUFFERED="1")
+    sim = subprocess.Popen([str(SIM), "_gui:=true"], env=env, stdout=subprocess.PIPE,
+                           stderr=subprocess.STDOUT, text=True)
+    try:
+        reader = subprocess.run([sys.executable, "-c", READ_POSE], env=env, capture_output=True,
+                                text=True, timeout=40)
+        assert reader.returncode == 0, reader.stderr
+        assert float(reader.stdout.split()[-1]) == pytest.approx(5.544, abs=1e-3)
+    finally:
+        sim.send_signal(signal.SIGINT)
+        try:
+            output, _ = sim.communicate(timeout=15)
+        except subprocess.TimeoutExpired:
+            sim.kill()
+            output, _ = sim.communicate()
+    assert sim.returncode == 0
+    assert "cannot open a window" in output and "running headless" in output
+    assert "Traceback" not in output

@@ -16,6 +16,10 @@ from turtlesim_core.png import encode_png
 REFRESH_MS = 33
 
 
+class WindowUnavailable(Exception):
+    """DISPLAY is set but no window can be opened there (no X server, no permission)."""
+
+
 def display_available() -> bool:
     """Whether a window can be opened at all: a DISPLAY and an importable tkinter."""
     if not os.environ.get("DISPLAY"):
@@ -32,7 +36,10 @@ def run_window(title: str, frame: Callable[[], Canvas], should_close: Callable[[
     """Block in Tk's main loop until the window is closed or ``should_close()`` turns true."""
     import tkinter as tk
 
-    root = tk.Tk()
+    try:
+        root = tk.Tk()
+    except tk.TclError as exc:
+        raise WindowUnavailable(str(exc)) from None
     root.title(title)
     root.resizable(False, False)
     first = frame()
