@@ -118,6 +118,9 @@ class Interpreter:
         ns = self.options.ros_namespace
         if ns is None:
             ns = os.environ.get("ROS_NAMESPACE", "/") or "/"
+        if ns.startswith("~"):
+            raise LaunchError(f"ROS_NAMESPACE [{ns}] must be a global or relative namespace",
+                              Location(filename))
         scope = Scope(ns, filename, include_stack=(os.path.abspath(filename),))
         scope.args = dict(self.options.args)
         self._check_launch_tag(root, scope)
