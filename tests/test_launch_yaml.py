@@ -179,3 +179,20 @@ def test_parse_file_missing_is_an_orchestra_error(tmp_path):
     with pytest.raises(OrchestraError) as info:
         parse_file(str(tmp_path / "none.launch.yaml"))
     assert "not found" in info.value.message
+
+
+def test_example_yaml_launch_file_resolves_like_its_xml_original(compat_dir):
+    """launch/turtle_tf_demo.launch.yaml, written by hand with ROS 2 spellings, launches
+    exactly what turtle_tf's XML demo does."""
+    from conftest import REPO
+    from orchestra.launch.interpreter import load_launch
+
+    def plan_of(path):
+        data = load_launch(str(path), no_exec=True).to_json()
+        for node in data["nodes"]:
+            node["filename"] = None
+        data["files_loaded"] = []
+        return data
+
+    assert plan_of(REPO / "launch" / "turtle_tf_demo.launch.yaml") == \
+        plan_of(compat_dir / "ws" / "turtle_tf" / "launch" / "turtle_tf_demo.launch")
