@@ -81,8 +81,10 @@ def role_sub(kind: str, count: int, burst: int) -> None:
     def callback(m):
         t = now()
         if m.angular.z if kind == "twist" else m.header.frame_id == "burst":
+            if not burst_times:
+                burst_times.append(read_stamp(kind, m))  # when the burst was started
             burst_times.append(t)
-            if len(burst_times) >= burst:
+            if len(burst_times) > burst:
                 done.set()
         else:
             latencies.append(t - read_stamp(kind, m))
@@ -93,10 +95,10 @@ def role_sub(kind: str, count: int, burst: int) -> None:
     line = sys.stdin.readline()  # "latency done" from the parent
     emit({"latency": summarize(latencies)})
     done.wait(float(line.split()[-1]) if line.strip() else 30.0)
-    received = len(burst_times)
-    span = burst_times[-1] - burst_times[0] if received > 1 else float("nan")
-    emit({"throughput": {"received": received, "msgs_per_s": (received - 1) / span,
-                         "mb_per_s": (received - 1) * len(msg.serialize_bytes()) / span / 1e6}})
+    received = len(burst_times) - 1
+    span = burst_times[-1] - burst_times[0] if received > 0 else float("nan")
+    emit({"throughput": {"received": received, "msgs_per_s": received / span,
+                         "mb_per_s": received * len(msg.serialize_bytes()) / span / 1e6}})
     rospy.signal_shutdown("done")
 
 
@@ -120,7 +122,9 @@ def role_pub(kind: str, count: int, burst: int) -> None:
         msg.angular.z = 1.0
     else:
         msg.header.frame_id = "burst"
-    for _ in range(burst):
+    stamp(kind, msg, now())
+    pub.publish(msg)  # the first burst message carries the start time
+    for _ in range(burst - 1):
         pub.publish(msg)
     impl = pub._impl
     deadline = now() + 30
@@ -177,14 +181,15 @@ def role_raw_server(size: int, count: int, burst: int) -> None:
         (n,) = struct.unpack("<I", f.read(4))
         body = f.read(n)
         lat.append(now() - struct.unpack_from("<d", body)[0])
-    times = []
+    start = None
     for _ in range(burst):
         (n,) = struct.unpack("<I", f.read(4))
-        f.read(n)
-        times.append(now())
-    span = times[-1] - times[0]
-    emit({"latency": summarize(lat), "throughput": {"msgs_per_s": (burst - 1) / span,
-                                                    "mb_per_s": (burst - 1) * size / span / 1e6}})
+        body = f.read(n)
+        if start is None:
+            start = struct.unpack_from("<d", body)[0]
+    span = now() - start
+    emit({"latency": summarize(lat), "throughput": {"msgs_per_s": burst / span,
+                                                    "mb_per_s": burst * size / span / 1e6}})
     # request/response round trips for the service baseline
     while True:
         head = f.read(4)
@@ -207,6 +212,7 @@ def raw_baseline(size: int, count: int, burst: int, calls: int, gap: float) -> d
         struct.pack_into("<d", payload, 0, now())
         sock.sendall(struct.pack("<I", size) + payload)
         time.sleep(gap)
+    struct.pack_into("<d", payload, 0, now())
     for _ in range(burst):
         sock.sendall(struct.pack("<I", size) + payload)
     result = json.loads(proc.stdout.readline())

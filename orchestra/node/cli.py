@@ -261,7 +261,8 @@ class _Decoder:
 def _subscribe_raw(rospy, name: str):
     from orchestra.node.msg import AnyMsg
     inbox: queue.Queue = queue.Queue()
-    sub = rospy.Subscriber(name, AnyMsg, lambda m: inbox.put((time.monotonic(), m)))
+    sub = rospy.Subscriber(name, AnyMsg, lambda m: inbox.put((time.monotonic(), m)),
+                           queue_size=0)
     return sub, inbox
 
 

@@ -13,6 +13,7 @@ import collections
 import logging
 import select
 import socket
+import struct
 import threading
 import time
 from typing import TYPE_CHECKING, Any, Callable
@@ -21,6 +22,8 @@ from orchestra.node import tcpros
 from orchestra.node.exceptions import ROSException, TransportException
 from orchestra.node.masterapi import MasterError, raw_call
 from orchestra.node.msg import AnyMsg, Message
+
+_U32 = struct.Struct("<I")
 
 if TYPE_CHECKING:
     from orchestra.node.runtime import NodeRuntime
@@ -313,23 +316,51 @@ class InConnection:
                 return
 
     def _read_loop(self, sock: socket.socket) -> None:
+        """Read whatever the socket holds, keep the newest ``queue_size`` complete messages,
+        deliver them. This is rospy's queue_size rule: a slow callback sees fresh data, not
+        a backlog piled up in socket buffers."""
         sub = self.subscription
         header = self.header
         cls = sub.msg_class
+        keep = sub.queue_size
+        buf = bytearray()
+        need = 4
         while not self.closed.is_set():
-            data = tcpros.read_message(sock)
-            self.bytes_received += len(data) + 4
-            self.messages_received += 1
-            if cls is AnyMsg:
-                msg = AnyMsg(data)
-            else:
-                try:
-                    msg = cls.deserialize_bytes(data)
-                except ROSException as exc:
-                    log.error("bad message on %s from %s: %s", sub.topic, self.uri, exc)
-                    continue
-            msg._connection_header = header
-            sub.deliver(msg)
+            chunk = sock.recv(max(need - len(buf), 65536))
+            if not chunk:
+                raise TransportException("connection closed by peer")
+            buf += chunk
+            if len(buf) < need:
+                continue
+            frames: list[bytes] = []
+            pos = 0
+            with memoryview(buf) as view:
+                while len(buf) - pos >= 4:
+                    (size,) = _U32.unpack_from(view, pos)
+                    if size > tcpros.MAX_MESSAGE:
+                        raise TransportException(f"message of {size} bytes refused")
+                    if len(buf) - pos - 4 < size:
+                        break
+                    frames.append(bytes(view[pos + 4:pos + 4 + size]))
+                    pos += 4 + size
+            del buf[:pos]
+            need = 4 if len(buf) < 4 else 4 + _U32.unpack_from(buf, 0)[0]
+            if keep and len(frames) > keep:
+                self.drops += len(frames) - keep
+                frames = frames[-keep:]
+            for data in frames:
+                self.bytes_received += len(data) + 4
+                self.messages_received += 1
+                if cls is AnyMsg:
+                    msg = AnyMsg(data)
+                else:
+                    try:
+                        msg = cls.deserialize_bytes(data)
+                    except ROSException as exc:
+                        log.error("bad message on %s from %s: %s", sub.topic, self.uri, exc)
+                        continue
+                msg._connection_header = header
+                sub.deliver(msg)
 
 
 class _Refused(Exception):
@@ -339,10 +370,12 @@ class _Refused(Exception):
 class Subscription:
     """Everything this node knows about one topic it subscribes to."""
 
-    def __init__(self, runtime: "NodeRuntime", topic: str, msg_class: type[Message]):
+    def __init__(self, runtime: "NodeRuntime", topic: str, msg_class: type[Message],
+                 queue_size: int | None = None):
         self.runtime = runtime
         self.topic = topic
         self.msg_class = msg_class
+        self.queue_size = queue_size or 0
         self.lock = threading.Lock()
         self.callback_lock = threading.Lock()
         self.callbacks: list[tuple[Callable, Any]] = []
@@ -410,7 +443,8 @@ class Subscription:
 
 class Subscriber:
     """Call ``callback(msg)`` (or ``callback(msg, callback_args)``) for each message on
-    ``topic``, from a receive thread. ``queue_size`` is accepted for rospy compatibility."""
+    ``topic``, from a receive thread. When messages arrive faster than the callback runs,
+    only the newest ``queue_size`` of those waiting are delivered (None/0: all)."""
 
     def __init__(self, topic: str, msg_class: type[Message], callback: Callable | None = None,
                  callback_args: Any = None, queue_size: int | None = 10, **_ignored: Any):
@@ -424,7 +458,7 @@ class Subscriber:
         self.type = msg_class._type
         self.callback = callback
         self.callback_args = callback_args
-        self._impl = self._rt.topics.acquire_subscription(self.name, msg_class)
+        self._impl = self._rt.topics.acquire_subscription(self.name, msg_class, queue_size)
         if callback is not None:
             self._impl.add_callback(callback, callback_args)
         self._done = False
@@ -475,15 +509,20 @@ class TopicManager:
         self.rt.master_unregister("unregisterPublisher", pub.topic)
         pub.close()
 
-    def acquire_subscription(self, topic: str, msg_class: type[Message]) -> Subscription:
+    def acquire_subscription(self, topic: str, msg_class: type[Message],
+                             queue_size: int | None = None) -> Subscription:
         with self.lock:
             sub = self.subscriptions.get(topic)
             if sub is not None:
                 if not md5_compatible(sub.msg_class._md5sum, msg_class._md5sum):
                     raise ROSException(f"{topic} is already subscribed here as {sub.type}, "
                                        f"cannot also subscribe as {msg_class._type}")
+                if queue_size and (not sub.queue_size or queue_size > sub.queue_size):
+                    sub.queue_size = queue_size
+                elif not queue_size:
+                    sub.queue_size = 0
                 return sub
-            sub = Subscription(self.rt, topic, msg_class)
+            sub = Subscription(self.rt, topic, msg_class, queue_size)
             self.subscriptions[topic] = sub
         publishers = self.rt.master_register("registerSubscriber", topic, msg_class._type)
         sub.update_publishers(list(publishers or []))
