@@ -168,6 +168,12 @@ def test_wrong_shape_is_a_located_error(text, fragment):
     assert err.location is not None and err.location.file == "t.launch.yaml"
 
 
+def test_list_of_attribute_maps_under_a_tag_explains_the_one_item_per_element_rule():
+    err = error_of("launch:\n  - param: [{name: a, value: 1}, {name: b, value: 2}]\n")
+    assert "one '- param:' item each" in err.message
+    assert (err.location.line, err.location.column) == (2, 13)
+
+
 def test_parse_file_reads_from_disk_and_names_the_path(tmp_path):
     path = tmp_path / "x.launch.yaml"
     path.write_text("launch:\n  - arg: {name: a}\n")

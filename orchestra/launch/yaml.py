@@ -174,7 +174,7 @@ def _element(tag: str, key: Node, body: Node, filename: str) -> Entity:
             f"got the value '{body.value}' (element text goes under '{TEXT_KEY}:')",
             _location(filename, body))
     if isinstance(body, SequenceNode):
-        entity.children.extend(_children(body, filename))
+        entity.children.extend(_children(body, filename, list_of=tag))
         return entity
     aliases = ATTRIBUTE_ALIASES.get(tag, {})
     for item_key, value in _mapping_items(body, filename):
@@ -257,17 +257,27 @@ def _last_wins_for_merged(pairs: list[tuple[Node, Node]], merged_count: int
     return result
 
 
-def _children(sequence: SequenceNode, filename: str) -> list[Entity]:
-    """A list of ``- tag: body`` items (nested lists are flattened in place)."""
+def _children(sequence: SequenceNode, filename: str, list_of: str | None = None
+              ) -> list[Entity]:
+    """A list of ``- tag: body`` items (nested lists are flattened in place).
+
+    ``list_of`` is the tag whose body this list is (``- group: [...]``), for the error hint
+    when someone meant several elements of that tag.
+    """
     children: list[Entity] = []
     for item in sequence.value:
         if isinstance(item, SequenceNode):
-            children.extend(_children(item, filename))
+            children.extend(_children(item, filename, list_of))
             continue
         if not isinstance(item, MappingNode) or len(item.value) != 1:
+            hint = ""
+            if list_of and isinstance(item, MappingNode):
+                hint = (f"; a list under '{list_of}:' holds the children of one <{list_of}>"
+                        f" — for several <{list_of}> elements write one '- {list_of}:' item"
+                        " each")
             raise LaunchYamlError(
                 "each list item must be one element written as '- tag: {attributes}' "
-                "(a mapping with exactly one key)", _location(filename, item))
+                "(a mapping with exactly one key)" + hint, _location(filename, item))
         key, body = item.value[0]
         children.append(_element(_key_text(key, filename), key, body, filename))
     return children
