@@ -56,3 +56,12 @@ def test_partial_lines_are_joined_across_reads():
     output.feed("out", b"lo\nwor")
     output.feed("out", b"ld\n")
     assert screen.out.getvalue() == b"[/n] hello\n[/n] world\n"
+
+
+def test_endless_line_is_shown_once_it_passes_the_limit():
+    from orchestra.supervise.output import MAX_LINE
+
+    screen = Screen(out=io.BytesIO(), err=io.BytesIO(), colour=False)
+    output = NodeOutput("/n", OutputMode.SCREEN, screen, None, None)
+    output.feed("out", b"x" * (MAX_LINE + 1))
+    assert screen.out.getvalue() == b"[/n] " + b"x" * (MAX_LINE + 1) + b"\n"

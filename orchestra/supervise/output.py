@@ -15,6 +15,8 @@ from typing import BinaryIO
 
 from orchestra.supervise.process import OutputMode
 
+MAX_LINE = 65536   # console bytes held back waiting for a newline
+
 _COLOURS = (31, 32, 33, 34, 35, 36, 91, 92, 93, 94, 95, 96)
 
 
@@ -207,7 +209,11 @@ class NodeOutput:
         buf = self._partial[stream] + data
         cut = buf.rfind(b"\n")
         if cut < 0:
-            self._partial[stream] = buf
+            if len(buf) > MAX_LINE:      # no newline for too long (progress bars): show it
+                self._partial[stream] = b""
+                self.screen.write_lines(self._prefix + buf + b"\n", stream)
+            else:
+                self._partial[stream] = buf
             return
         self._partial[stream] = buf[cut + 1:]
         lines = buf[:cut].split(b"\n")

@@ -224,8 +224,13 @@ class Supervisor:
 
     # ------------------------------------------------------------------ events
 
-    def _on_output(self, fd: int, stream: str, pipe, output: NodeOutput) -> None:
-        while True:
+    def _on_output(self, fd: int, stream: str, pipe, output: NodeOutput,
+                   max_reads: int | None = 16) -> None:
+        """Forward what is in the pipe; a bounded number of reads so one chatty node cannot
+        starve the loop (the selector calls again while data remains)."""
+        reads = 0
+        while max_reads is None or reads < max_reads:
+            reads += 1
             try:
                 data = os.read(fd, 65536)
             except BlockingIOError:
@@ -244,7 +249,7 @@ class Supervisor:
         """Read everything the dead child left in its pipes, so no last line is lost."""
         for stream, pipe in (("out", child.popen.stdout), ("err", child.popen.stderr)):
             if pipe is not None and not pipe.closed:
-                self._on_output(pipe.fileno(), stream, pipe, output)
+                self._on_output(pipe.fileno(), stream, pipe, output, max_reads=None)
 
     def _wait_in_thread(self, proc: ManagedProcess, popen: subprocess.Popen) -> None:
         popen.wait()
@@ -292,7 +297,8 @@ class Supervisor:
             proc.transition(State.EXITED, described)
             text = ("has finished cleanly" if code == 0
                     else f"has died [pid {child.popen.pid}, {described}]")
-            self.screen.message(f"process[{spec.name}]: {text}", err=code != 0)
+            self.screen.message(f"process[{spec.name}]: {text}{self._log_hint(spec)}",
+                                err=code != 0)
             self._changed()
             return
         proc.short_runs = 1 if uptime >= self.policy.stable_after else proc.short_runs + 1
@@ -306,7 +312,8 @@ class Supervisor:
             return
         proc.transition(State.BACKOFF, f"{described}; respawn in {delay:.3g} s")
         self.screen.message(f"process[{spec.name}]: died ({described}), respawning"
-                            + (f" in {delay:.3g} s" if delay > 0 else ""), err=True)
+                            + (f" in {delay:.3g} s" if delay > 0 else "")
+                            + self._log_hint(spec), err=True)
         proc.restarts += 1
         if delay <= 0:
             self._spawn(proc)
@@ -328,6 +335,12 @@ class Supervisor:
             self._cancel_timer(proc)
 
     # ------------------------------------------------------------------ helpers
+
+    def _log_hint(self, spec: ProcessSpec) -> str:
+        """roslaunch's pointer to the log files of a node that died."""
+        if self.outputs[spec.name].files and self.log_dir and spec.log_name:
+            return f"\nlog file: {os.path.join(self.log_dir, spec.log_name)}*.log"
+        return ""
 
     def _set_timer(self, proc: ManagedProcess, delay: float, callback: Callable[[], None]) -> None:
         self._cancel_timer(proc)
