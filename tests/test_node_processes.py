@@ -317,3 +317,15 @@ def test_node_started_before_the_master_waits_for_it(package_path):
             handle.shutdown()
     finally:
         group.close()
+
+
+def test_slow_subscriber_with_queue_size_one_skips_to_the_newest_message(nodes):
+    sub = nodes.start("sub.py", "burst", "std_msgs/Int32", "--queue", "1", "--slow", "0.3")
+    sub.ready()
+    pub = nodes.start("pub.py", "burst", "std_msgs/Int32", "data: $N", "--count", "200",
+                      "--rate", "1000", "--latch")
+    pub.expect(lambda d: d.get("sent") == 200)
+    last = sub.expect(lambda d: d.get("msg") == {"data": 199}, timeout=15)
+    received = [d["msg"]["data"] for d in sub.seen if "msg" in d]
+    assert last and received == sorted(received)
+    assert len(received) < 50  # most of the backlog was dropped, not queued
