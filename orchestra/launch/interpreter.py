@@ -499,14 +499,9 @@ class Interpreter:
     def _add_rosparam(self, entity: Entity, name: str, value: Any) -> None:
         if name == "/" and not isinstance(value, dict):
             raise self._error(entity, "cannot load a non-dictionary into the global namespace")
-        stack = [(name, value)]
-        while stack:
-            key, val = stack.pop()
-            if isinstance(val, dict):
-                for sub, subval in reversed(list(val.items())):
-                    stack.append((ns_join(key, str(sub)), subval))
-            else:
-                self._set_param(key, Binary(val) if isinstance(val, bytes) else val)
+        from orchestra.params.yaml import flatten
+        for key, val in flatten(name, value):
+            self._set_param(key, Binary(val) if isinstance(val, bytes) else val)
 
     # ---------------------------------------------------------------- node / test
     def _node(self, entity: Entity, scope: Scope, default_machine: Machine | None
