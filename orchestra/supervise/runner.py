@@ -323,7 +323,12 @@ def run_plan(plan: LaunchPlan, options: Mapping[str, Any]) -> int:
         def make_snapshot() -> dict[str, Any]:
             return snapshot(supervisor.procs, stats, info)
 
-        server = StatusServer(supervisor.loop, make_snapshot)
+        try:
+            server: StatusServer | None = StatusServer(supervisor.loop, make_snapshot)
+        except OSError as exc:       # status is a convenience: never a reason not to run
+            logger.warning("no status socket (orchestra status will not see this launch): %s",
+                           exc)
+            server = None
         rpc = LaunchRPCServer(supervisor.loop, supervisor.procs, make_snapshot,
                               loopback=_is_loopback_uri(master.uri))
         uris_key = uris_param(rpc.host, rpc.port)
@@ -338,7 +343,8 @@ def run_plan(plan: LaunchPlan, options: Mapping[str, Any]) -> int:
         finally:
             if view is not None:
                 view.close()
-            server.close()
+            if server is not None:
+                server.close()
             rpc.close()
             if master.handle is None:       # roslaunch leaves it behind; we do not
                 _delete_param(master.uri, uris_key)

@@ -19,16 +19,18 @@ from orchestra.supervise.loop import EventLoop
 from orchestra.supervise.process import ManagedProcess, State
 
 SNAPSHOT_VERSION = 1
+MAX_SOCKET_DIR = 90
 
 
 def runtime_dir(environ: dict[str, str] | None = None) -> str:
     """The per-user directory holding the status sockets (created 0700 when missing)."""
     env = os.environ if environ is None else environ
     base = env.get("XDG_RUNTIME_DIR")
-    if base and os.path.isdir(base) and os.access(base, os.W_OK):
+    path = os.path.join("/tmp", f"orchestra-{os.getuid()}")
+    # a Unix socket path must fit in 108 bytes ("/<pid>.sock" included)
+    if base and os.path.isdir(base) and os.access(base, os.W_OK) \
+            and len(os.path.join(base, "orchestra")) <= MAX_SOCKET_DIR:
         path = os.path.join(base, "orchestra")
-    else:
-        path = os.path.join("/tmp", f"orchestra-{os.getuid()}")
     os.makedirs(path, mode=0o700, exist_ok=True)
     return path
 
