@@ -174,6 +174,32 @@ def test_list_of_attribute_maps_under_a_tag_explains_the_one_item_per_element_ru
     assert (err.location.line, err.location.column) == (2, 13)
 
 
+def test_aliases_are_copied_into_the_tree():
+    root = parse("launch:\n  - group: &g [{arg: {name: a}}]\n  - group: *g\n")
+    assert [c.children[0].get("name") for c in root.children] == ["a", "a"]
+
+
+@pytest.mark.parametrize("text", [
+    "launch: &a [*a]\n",
+    "launch:\n  - group: &g {children: [{group: *g}]}\n",
+])
+def test_recursive_alias_is_refused(text):
+    assert "recursive alias" in error_of(text).message
+
+
+def test_alias_bomb_is_refused_not_expanded():
+    lines = ["launch:", "  - group: &a0 [{arg: {name: x}}, {arg: {name: y}}]"]
+    for i in range(1, 10):
+        refs = ", ".join([f"*a{i - 1}"] * 10)
+        lines.append(f"  - group: &a{i} [{refs}]")
+    assert "more than" in error_of("\n".join(lines) + "\n").message
+
+
+def test_self_merge_is_refused_without_a_traceback():
+    err = error_of("launch:\n  - node: &n {pkg: p, <<: *n}\n")
+    assert err.location.file == "t.launch.yaml"
+
+
 def test_parse_file_reads_from_disk_and_names_the_path(tmp_path):
     path = tmp_path / "x.launch.yaml"
     path.write_text("launch:\n  - arg: {name: a}\n")

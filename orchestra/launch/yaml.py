@@ -106,7 +106,12 @@ def parse_string(text: str, filename: str = "<string>") -> Entity:
             "a YAML launch file must be one mapping with the single key 'launch:' "
             "(for example 'launch: [...]')", _location(filename, root))
     key, body = root.value[0]
-    return _element(_key_text(key, filename), key, body, filename)
+    try:
+        return _element(_key_text(key, filename), key, body, filename, _Guard())
+    except RecursionError:
+        # nesting (or a self-merging `<<: *x`) deeper than Python's stack: refuse, no trace
+        raise LaunchYamlError("the document nests too deeply to be a launch file",
+                              _location(filename, root)) from None
 
 
 def _compose(text: str, filename: str) -> Node | None:
@@ -160,8 +165,40 @@ def _key_text(key: Node, filename: str) -> str:
     return key.value
 
 
-def _element(tag: str, key: Node, body: Node, filename: str) -> Entity:
+class _Guard:
+    """Stops YAML aliases from expanding forever (``&a [*a]``) or exponentially (a few
+    nested aliases repeated: the "billion laughs"): Entities are a tree, aliases are copied."""
+
+    MAX_ELEMENTS = 100_000
+
+    def __init__(self) -> None:
+        self.active: set[int] = set()
+        self.count = 0
+
+    def enter(self, node: Node, filename: str) -> None:
+        if id(node) in self.active:
+            raise LaunchYamlError("a YAML alias refers to an element that contains it "
+                                  "(recursive alias)", _location(filename, node))
+        self.count += 1
+        if self.count > self.MAX_ELEMENTS:
+            raise LaunchYamlError(f"more than {self.MAX_ELEMENTS} elements after expanding "
+                                  "YAML aliases", _location(filename, node))
+        self.active.add(id(node))
+
+    def leave(self, node: Node) -> None:
+        self.active.discard(id(node))
+
+
+def _element(tag: str, key: Node, body: Node, filename: str, guard: _Guard) -> Entity:
     """One element: ``tag`` written at ``key`` with ``body`` (attributes/children/text)."""
+    guard.enter(body, filename)
+    try:
+        return _element_body(tag, key, body, filename, guard)
+    finally:
+        guard.leave(body)
+
+
+def _element_body(tag: str, key: Node, body: Node, filename: str, guard: _Guard) -> Entity:
     entity = Entity(tag=tag, location=_location(filename, key))
     attribute_locations: dict[str, Location] = {}
     setattr(entity, ENTITY_ATTRIBUTE_LOCATIONS, attribute_locations)
@@ -174,7 +211,7 @@ def _element(tag: str, key: Node, body: Node, filename: str) -> Entity:
             f"got the value '{body.value}' (element text goes under '{TEXT_KEY}:')",
             _location(filename, body))
     if isinstance(body, SequenceNode):
-        entity.children.extend(_children(body, filename, list_of=tag))
+        entity.children.extend(_children(body, filename, guard, list_of=tag))
         return entity
     aliases = ATTRIBUTE_ALIASES.get(tag, {})
     for item_key, value in _mapping_items(body, filename):
@@ -184,7 +221,7 @@ def _element(tag: str, key: Node, body: Node, filename: str) -> Entity:
             if not isinstance(value, SequenceNode):
                 raise LaunchYamlError(f"'{CHILDREN_KEY}:' of <{tag}> must be a list of "
                                       "elements", _location(filename, value))
-            entity.children.extend(_children(value, filename))
+            entity.children.extend(_children(value, filename, guard))
         elif name == TEXT_KEY:
             if not isinstance(value, ScalarNode):
                 raise LaunchYamlError(f"'{TEXT_KEY}:' of <{tag}> must be a string (use a "
@@ -202,9 +239,9 @@ def _element(tag: str, key: Node, body: Node, filename: str) -> Entity:
             # ROS 2 style: `param: [{name: a, value: 1}]` or `remap: {from: a, to: b}`
             if isinstance(value, SequenceNode):
                 for item in value.value:
-                    entity.children.append(_element(name, item, item, filename))
+                    entity.children.append(_element(name, item, item, filename, guard))
             else:
-                entity.children.append(_element(name, item_key, value, filename))
+                entity.children.append(_element(name, item_key, value, filename, guard))
         else:
             raise LaunchYamlError(
                 f"attribute '{name}' of <{tag}> must be a single value, not a "
@@ -257,8 +294,8 @@ def _last_wins_for_merged(pairs: list[tuple[Node, Node]], merged_count: int
     return result
 
 
-def _children(sequence: SequenceNode, filename: str, list_of: str | None = None
-              ) -> list[Entity]:
+def _children(sequence: SequenceNode, filename: str, guard: _Guard,
+              list_of: str | None = None) -> list[Entity]:
     """A list of ``- tag: body`` items (nested lists are flattened in place).
 
     ``list_of`` is the tag whose body this list is (``- group: [...]``), for the error hint
@@ -266,21 +303,28 @@ def _children(sequence: SequenceNode, filename: str, list_of: str | None = None
     """
     children: list[Entity] = []
     for item in sequence.value:
-        if isinstance(item, SequenceNode):
-            children.extend(_children(item, filename, list_of))
-            continue
-        if not isinstance(item, MappingNode) or len(item.value) != 1:
-            hint = ""
-            if list_of and isinstance(item, MappingNode):
-                hint = (f"; a list under '{list_of}:' holds the children of one <{list_of}>"
-                        f" — for several <{list_of}> elements write one '- {list_of}:' item"
-                        " each")
-            raise LaunchYamlError(
-                "each list item must be one element written as '- tag: {attributes}' "
-                "(a mapping with exactly one key)" + hint, _location(filename, item))
-        key, body = item.value[0]
-        children.append(_element(_key_text(key, filename), key, body, filename))
+        children.extend(_child(item, filename, guard, list_of))
     return children
+
+
+def _child(item: Node, filename: str, guard: _Guard, list_of: str | None) -> list[Entity]:
+    """The element(s) of one list item."""
+    if isinstance(item, SequenceNode):
+        guard.enter(item, filename)
+        try:
+            return _children(item, filename, guard, list_of)
+        finally:
+            guard.leave(item)
+    if not isinstance(item, MappingNode) or len(item.value) != 1:
+        hint = ""
+        if list_of and isinstance(item, MappingNode):
+            hint = (f"; a list under '{list_of}:' holds the children of one <{list_of}>"
+                    f" — for several <{list_of}> elements write one '- {list_of}:' item each")
+        raise LaunchYamlError(
+            "each list item must be one element written as '- tag: {attributes}' "
+            "(a mapping with exactly one key)" + hint, _location(filename, item))
+    key, body = item.value[0]
+    return [_element(_key_text(key, filename), key, body, filename, guard)]
 
 
 def is_yaml_launch_file(path: str) -> bool:
