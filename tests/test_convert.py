@@ -192,6 +192,17 @@ def test_reserved_attribute_name_cannot_be_written_as_yaml():
         convert.to_yaml(entity)
 
 
+@pytest.mark.parametrize("entity", [
+    Entity("launch", children=[Entity("rosparam", text="a: \x01")]),
+    Entity("launch", children=[Entity("param", {"value": "\x02"})]),
+    Entity("launch", children=[Entity("param", {"my attr": "x"})]),
+    Entity("launch", children=[Entity("1tag")]),
+])
+def test_what_xml_cannot_hold_is_a_located_error(entity):
+    with pytest.raises(OrchestraError, match="cannot be written as XML|not a valid XML"):
+        convert.to_xml(entity)
+
+
 def test_yaml_aliases_are_written_back_with_roslaunch_names(tmp_path):
     src = tmp_path / "a.launch.yaml"
     src.write_text("launch:\n  - node: {pkg: p, exec: t, namespace: n}\n")

@@ -164,7 +164,11 @@ def _xml_element(entity: Entity, depth: int) -> etree._Element:
     # text and the whitespace between children as one string, so indenting around real text
     # would change it.
     indent = "\n" + "  " * (depth + 1) if text is None else None
-    element.text = text if text is not None else (indent if entity.children else None)
+    try:
+        element.text = text if text is not None else (indent if entity.children else None)
+    except ValueError:
+        raise ConvertError(f"the text of <{entity.tag}> cannot be written as XML (control "
+                           "characters)", entity.location) from None
     for index, child in enumerate(entity.children):
         sub = _xml_element(child, depth + 1)
         if indent is not None:
