@@ -42,8 +42,12 @@ class TransformListener:
     def _on_tf_static(self, msg: Any) -> None:
         self._store(msg, static=True)
 
-    def lookup_transform(self, target: str, source: str, time: Any = None) -> Transform:
-        """``(translation, quaternion)``: pose of ``source`` in ``target`` (time 0/None = latest)."""
+    def lookup_transform(self, target: str, source: str, time: Any = None,
+                         timeout: Any = None) -> Transform:
+        """``(translation, quaternion)``: pose of ``source`` in ``target`` (time 0/None = latest).
+        With a ``timeout`` (seconds or Duration) wait that long for it, as tf2_ros does."""
+        if timeout is not None and to_sec(timeout) > 0:
+            return self.wait_for_transform(target, source, time, timeout)
         return self.buffer.lookup(target, source, to_sec(time))[0]
 
     lookupTransform = lookup_transform  # noqa: N815 - tf's name
