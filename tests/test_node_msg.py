@@ -11,7 +11,7 @@ from orchestra.node import msgspec
 from orchestra.node.msg import (FillError, MessageNotFound, Registry, fill_message,
                                 get_message_class, get_service_class,
                                 message_class_from_definition, to_plain, to_yaml_text)
-from orchestra.node.rostime import Duration, Time
+from orchestra.node.rostime import Time
 
 STORE = get_typestore(Stores.ROS1_NOETIC)
 STANDARD = sorted(k.replace("/msg/", "/") for k in STORE.fielddefs
@@ -216,12 +216,3 @@ def test_msg_parser_keeps_string_constants_verbatim_and_resolves_relative_types(
     assert spec.constants[0].value == "hi # not a comment"
     assert [f.base for f in spec.fields] == ["std_msgs/Header", "pkg/Point"]
 
-
-def test_time_and_duration_arithmetic_and_normalisation():
-    assert Time(1, 1_500_000_000) == Time(2, 500_000_000)
-    assert (Time(3) - Time(1, 500_000_000)) == Duration(1, 500_000_000)
-    assert Duration(-1, 500_000_000).to_sec() == -0.5
-    assert Time.from_sec(1.25).nsecs == 250_000_000
-    assert (Time(1) + Duration(2)).secs == 3
-    with pytest.raises(ValueError):
-        Time(-1)

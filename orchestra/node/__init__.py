@@ -19,12 +19,13 @@ from orchestra.node.runtime import (delete_param, get_caller_id, get_master_uri,
                                     search_param, set_param, signal_shutdown, spin,
                                     wait_for_message)
 from orchestra.node.services import Service, ServiceProxy, wait_for_service
+from orchestra.node.timer import Timer, TimerEvent
 from orchestra.node.topics import Publisher, Subscriber
 
 __all__ = [
     "AnyMsg", "Duration", "Publisher", "ROSException", "ROSInitException",
     "ROSInterruptException", "Rate", "SerializationError", "Service", "ServiceException",
-    "ServiceProxy", "Subscriber", "Time", "TransportException", "delete_param",
+    "ServiceProxy", "Subscriber", "Time", "Timer", "TimerEvent", "TransportException", "delete_param",
     "get_caller_id", "get_master_uri", "get_message_class", "get_name", "get_namespace",
     "get_node_uri", "get_param", "get_param_cached", "get_param_names",
     "get_published_topics", "get_rostime", "get_service_class", "get_time", "has_param",
