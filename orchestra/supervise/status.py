@@ -251,12 +251,13 @@ class LiveView:
     def start(self) -> None:
         self._tick()
 
-    def _max_lines(self) -> int:
+    @staticmethod
+    def _terminal() -> tuple[int, int]:
         try:
-            rows = os.get_terminal_size().lines or 24   # 0 on a pty nobody sized
+            size = os.get_terminal_size()
+            return size.columns or 80, size.lines or 24   # 0 on a pty nobody sized
         except OSError:
-            rows = 24
-        return max(3, rows // 3)
+            return 80, 24
 
     def changed(self) -> None:
         """A state changed: redraw soon, once for a burst of changes (100 nodes starting)."""
@@ -268,7 +269,10 @@ class LiveView:
             self._pending.cancel()
             self._pending = None
         if not self._closed:
-            self._screen.set_footer(footer_lines(self._make()["nodes"], self._max_lines()))
+            columns, rows = self._terminal()
+            lines = footer_lines(self._make()["nodes"], max(3, rows // 3))
+            # a wrapped footer line would break the "cursor up N lines" erase
+            self._screen.set_footer([line[:columns - 1] for line in lines])
 
     def _tick(self) -> None:
         self.refresh()
