@@ -35,11 +35,11 @@ class Timer(threading.Thread):
             raise ValueError("Timer period must be positive")
         self._callback = callback
         self._oneshot = oneshot
-        self._stop = threading.Event()
+        self._cancelled = threading.Event()
         self.start()
 
     def shutdown(self) -> None:
-        self._stop.set()
+        self._cancelled.set()
 
     def run(self) -> None:
         from orchestra.node.runtime import is_shutdown
@@ -48,9 +48,9 @@ class Timer(threading.Thread):
         expected = Time.now() + period
         last_expected = last_real = None
         last_duration = None
-        while not self._stop.is_set() and not is_shutdown():
+        while not self._cancelled.is_set() and not is_shutdown():
             delay = (expected - Time.now()).to_sec()
-            if delay > 0 and self._stop.wait(delay):
+            if delay > 0 and self._cancelled.wait(delay):
                 return
             if is_shutdown():
                 return
