@@ -65,6 +65,14 @@ def test_turtlebot_environment_variables_choose_the_defaults(tmp_path):
     assert params["/mobile_base/device_port"] == "/dev/ttyUSB0"
 
 
+def test_battery_arg_adds_the_laptop_battery_monitor(tmp_path):
+    result = dump_plan(tmp_path, "battery:=/sys/class/power_supply/BAT1")
+    assert result.returncode == 0, result.stderr
+    plan = json.loads(result.stdout)
+    assert "turtlebot_laptop_battery" in [n["name"] for n in plan["nodes"]]
+    assert plan["params"]["/turtlebot_laptop_battery/acpi_path"] == "/sys/class/power_supply/BAT1"
+
+
 def test_unknown_base_is_a_clear_error_naming_the_missing_file(tmp_path):
     result = dump_plan(tmp_path, "base:=roomba")
     assert result.returncode != 0
