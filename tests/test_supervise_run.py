@@ -341,3 +341,12 @@ def test_test_nodes_run_only_in_test_mode(run_env):
     assert not (run_env["out"] / "checker.json").exists()
     assert run_plan(plan, dict(OPTS, with_tests=True)) == 0
     assert (run_env["out"] / "checker.json").exists()
+
+
+def test_two_nodes_with_one_name_are_a_user_error(run_env):
+    plan = LaunchPlan(nodes=(Node("demo", "probe", "twin", filename="a.launch", line=1),
+                             Node("demo", "probe", "twin", filename="a.launch", line=5)))
+    with pytest.raises(OrchestraError) as info:
+        run_plan(plan, OPTS)
+    assert str(info.value).startswith("a.launch:5: ") and "a.launch:1" in str(info.value)
+    assert not (run_env["out"] / "twin.json").exists()

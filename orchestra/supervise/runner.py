@@ -138,6 +138,16 @@ def _check_machines(plan: LaunchPlan, nodes: list[Node], local: bool) -> None:
                 "on that machine, or pass --local to run every node here", _location(node))
 
 
+def _check_unique_names(nodes: list[Node]) -> None:
+    seen: dict[str, Node] = {}
+    for node in nodes:
+        first = seen.setdefault(node.full_name, node)
+        if first is not node:
+            where = f" (first at {_location(first)})" if first.filename else ""
+            raise OrchestraError(f"two nodes are named '{node.full_name}'{where}",
+                                 _location(node))
+
+
 def resolve_executables(nodes: list[Node]) -> dict[str, str]:
     """Full name -> executable for every node; ALL problems reported before anything starts."""
     found: dict[str, str] = {}
@@ -294,6 +304,7 @@ def run_plan(plan: LaunchPlan, options: Mapping[str, Any]) -> int:
     opts = RunOptions.from_kwargs(options)
     nodes = list(plan.nodes) + (list(plan.tests) if opts.with_tests else [])
     # --- everything that may be the user's fault, before anything starts
+    _check_unique_names(nodes)
     _check_machines(plan, nodes, opts.local)
     executables = resolve_executables(nodes)
 
