@@ -187,3 +187,13 @@ def test_conditions_default_to_a_ros1_noetic_environment(tmp_path, monkeypatch):
     assert m.depends(("exec",)) == ["roscpp", "python3-yaml"]
     monkeypatch.setenv("ROS_VERSION", "2")
     assert m.depends(("buildtool",)) == ["ament_cmake"]
+
+
+def test_every_bundled_demo_package_manifest_is_valid():
+    from orchestra.packages.discovery import BUNDLED_PACKAGES
+
+    manifests = sorted(glob.glob(f"{BUNDLED_PACKAGES}/*/package.xml"))
+    assert manifests
+    for path in manifests:
+        manifest = parse_manifest(path)
+        assert manifest.name and not manifest.warnings, (path, manifest.warnings)
