@@ -91,7 +91,13 @@ def parse_launch_file(path: str) -> Entity:
 
 
 class Interpreter:
-    """Builds one plan; use ``load_file``/``load_entity`` once, then ``plan()``."""
+    """Builds one plan; use ``load_file``/``load_entity`` once, then ``plan()``.
+
+    Subclass hooks (``orchestra check`` relies on them; keep their signatures):
+    ``_children(children, scope, default_machine) -> default_machine`` dispatches the
+    elements of a ``<launch>``/``<group>`` body, and ``_warn(entity, message)`` receives
+    every non-fatal problem (unknown tags and attributes, defunct ``<master>``, ...).
+    """
 
     def __init__(self, options: LoadOptions | None = None):
         self.options = options or LoadOptions()
