@@ -58,8 +58,9 @@ def libexec_dirs(package: str, environ: Mapping[str, str] | None = None,
     return []
 
 
-def _walk_matches(top: str, exe: str) -> list[str]:
-    """Executables named ``exe`` anywhere below ``top``, in a stable order."""
+def _walk_matches(top: str, exe: str, executable: bool = True) -> list[str]:
+    """Executables (or, with ``executable=False``, the other files) named ``exe`` anywhere
+    below ``top``, in a stable order."""
     matches: list[str] = []
     seen: set[str] = set()
     for directory, dirs, files in os.walk(top, topdown=True, followlinks=True):
@@ -71,7 +72,7 @@ def _walk_matches(top: str, exe: str) -> list[str]:
         dirs[:] = sorted(d for d in dirs if not d.startswith("."))
         if exe in files:
             candidate = os.path.join(directory, exe)
-            if is_executable(candidate):
+            if is_executable(candidate) == executable:
                 matches.append(os.path.abspath(candidate))
     return matches
 
@@ -116,6 +117,12 @@ def find_executable(package: str, exe: str) -> str:
     """
     matches = executable_candidates(package, exe)
     if not matches:
+        package_dir = find_package(package)
+        plain = [] if os.sep in exe else _walk_matches(package_dir, exe, executable=False)
+        if plain:
+            raise ExecutableNotFound(
+                f"'{exe}' in package '{package}' is not executable: {', '.join(plain)} "
+                f"(chmod +x {plain[0]})")
         raise ExecutableNotFound(
             f"cannot find executable '{exe}' in package '{package}' "
             f"({find_package(package)}): the file must exist in the package (or its catkin "
