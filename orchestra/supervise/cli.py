@@ -22,7 +22,7 @@ _OPTIONS = [
     click.option("--required", "all_required", is_flag=True,
                  help="Treat every node as required: any death stops the launch."),
     click.option("--local", is_flag=True,
-                 help="Run nodes of remote <machine>s on this machine."),
+                 help="Do not launch remote nodes (those of a <machine> that is not this one)."),
     click.option("--disable-title", is_flag=True, help="Do not set the terminal title."),
     click.option("-p", "--port", type=click.IntRange(0, 65535), default=None,
                  help="Port of the master to use or start (default: from ROS_MASTER_URI)."),

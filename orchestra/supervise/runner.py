@@ -126,16 +126,28 @@ def is_local_address(address: str) -> bool:
     return bool(resolved & (mine | {"127.0.0.1", "::1"}))
 
 
-def _check_machines(plan: LaunchPlan, nodes: list[Node], local: bool) -> None:
-    if local:
-        return
+def split_remote(plan: LaunchPlan, nodes: list[Node], local: bool) -> tuple[list[Node], list[Node]]:
+    """(nodes to run here, remote nodes skipped by ``--local``).
+
+    roslaunch starts nodes of a remote ``<machine>`` over ssh; orchestra does not, so such a
+    node is a user error unless ``--local`` (roslaunch's "do not launch remote nodes") says to
+    leave them out.
+    """
+    here: list[Node] = []
+    remote: list[Node] = []
     for node in nodes:
         machine = plan.machines.get(node.machine_name or "")
         if machine is not None and node.machine_name and not is_local_address(machine.address):
-            raise OrchestraError(
-                f"node '{node.full_name}' runs on machine '{machine.name}' "
-                f"({machine.address}); orchestra does not start nodes over ssh: run orchestra "
-                "on that machine, or pass --local to run every node here", _location(node))
+            if not local:
+                raise OrchestraError(
+                    f"node '{node.full_name}' runs on machine '{machine.name}' "
+                    f"({machine.address}); orchestra does not start nodes over ssh: run "
+                    "orchestra on that machine, or pass --local to leave remote nodes out",
+                    _location(node))
+            remote.append(node)
+        else:
+            here.append(node)
+    return here, remote
 
 
 def _check_unique_names(nodes: list[Node]) -> None:
@@ -305,7 +317,7 @@ def run_plan(plan: LaunchPlan, options: Mapping[str, Any]) -> int:
     nodes = list(plan.nodes) + (list(plan.tests) if opts.with_tests else [])
     # --- everything that may be the user's fault, before anything starts
     _check_unique_names(nodes)
-    _check_machines(plan, nodes, opts.local)
+    nodes, remote = split_remote(plan, nodes, opts.local)
     executables = resolve_executables(nodes)
 
     def echo(text: str) -> None:
@@ -322,6 +334,9 @@ def run_plan(plan: LaunchPlan, options: Mapping[str, Any]) -> int:
         if not opts.disable_title and plan.files_loaded:
             _set_title(" ".join(plan.files_loaded[:1]) + f" {master.uri}")
         echo(f"logging to {run_dir}")
+        for node in remote:
+            echo(f"--local: not starting remote node {node.full_name} "
+                 f"(machine {node.machine_name})")
         supervisor = Supervisor(specs, RestartPolicy(backoff_max=opts.backoff_max,
                                                      crash_limit=opts.crash_limit),
                                 screen=screen, log_dir=run_dir, watchdog=watchdog,
