@@ -321,7 +321,6 @@ class InConnection:
         a backlog piled up in socket buffers."""
         sub = self.subscription
         header = self.header
-        cls = sub.msg_class
         keep = sub.queue_size
         buf = bytearray()
         need = 4
@@ -351,16 +350,7 @@ class InConnection:
             for data in frames:
                 self.bytes_received += len(data) + 4
                 self.messages_received += 1
-                if cls is AnyMsg:
-                    msg = AnyMsg(data)
-                else:
-                    try:
-                        msg = cls.deserialize_bytes(data)
-                    except ROSException as exc:
-                        log.error("bad message on %s from %s: %s", sub.topic, self.uri, exc)
-                        continue
-                msg._connection_header = header
-                sub.deliver(msg)
+                sub.deliver_raw(data, header, self.uri)
 
 
 class _Refused(Exception):
@@ -378,7 +368,7 @@ class Subscription:
         self.queue_size = queue_size or 0
         self.lock = threading.Lock()
         self.callback_lock = threading.Lock()
-        self.callbacks: list[tuple[Callable, Any]] = []
+        self.callbacks: list[tuple[Callable, Any, type[Message]]] = []
         self.connections: dict[str, InConnection] = {}
         self.closed = False
 
@@ -386,22 +376,36 @@ class Subscription:
     def type(self) -> str:
         return self.msg_class._type
 
-    def add_callback(self, cb: Callable, cb_args: Any) -> None:
+    def add_callback(self, cb: Callable, cb_args: Any, cls: type[Message]) -> None:
         with self.lock:
-            self.callbacks.append((cb, cb_args))
+            self.callbacks = self.callbacks + [(cb, cb_args, cls)]
+            if self.msg_class is AnyMsg and cls is not AnyMsg:
+                self.msg_class = cls  # connections made from now on check the real md5
 
     def remove_callback(self, cb: Callable, cb_args: Any) -> int:
         with self.lock:
-            for i, (c, a) in enumerate(self.callbacks):
+            for i, (c, a, _cls) in enumerate(self.callbacks):
                 if c is cb and a is cb_args:
-                    del self.callbacks[i]
+                    self.callbacks = self.callbacks[:i] + self.callbacks[i + 1:]
                     break
             return len(self.callbacks)
 
-    def deliver(self, msg: Message) -> None:
-        callbacks = self.callbacks
+    def deliver_raw(self, data: bytes, header: dict[str, str], origin: str) -> None:
+        """Decode once per message class the callbacks asked for, then call them in order."""
+        decoded: dict[type, Message | None] = {}
         with self.callback_lock:
-            for cb, args in callbacks:
+            for cb, args, cls in self.callbacks:
+                if cls not in decoded:
+                    try:
+                        msg = AnyMsg(data) if cls is AnyMsg else cls.deserialize_bytes(data)
+                        msg._connection_header = header
+                    except ROSException as exc:
+                        log.error("bad message on %s from %s: %s", self.topic, origin, exc)
+                        msg = None
+                    decoded[cls] = msg
+                msg = decoded[cls]
+                if msg is None:
+                    continue
                 try:
                     if args is None:
                         cb(msg)
@@ -460,7 +464,7 @@ class Subscriber:
         self.callback_args = callback_args
         self._impl = self._rt.topics.acquire_subscription(self.name, msg_class, queue_size)
         if callback is not None:
-            self._impl.add_callback(callback, callback_args)
+            self._impl.add_callback(callback, callback_args, msg_class)
         self._done = False
 
     def get_num_connections(self) -> int:
