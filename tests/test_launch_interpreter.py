@@ -202,3 +202,11 @@ def test_yaml_launch_file_uses_the_same_rules_and_can_include_xml(write):
     assert plan.params == {"/g/rate": 5}
     assert [(n.full_name, n.args) for n in plan.nodes] == [("/g/x", "me")]
     assert plan.files_loaded == (path, path.replace("main.launch.yaml", "inc.launch"))
+
+
+def test_error_in_included_file_keeps_its_location_and_names_the_include(write):
+    write("inc.launch", '<launch>\n<node name="n" pkg="p" type="t" respawn="x"/></launch>')
+    with pytest.raises(OrchestraError) as info:
+        launch(write, '\n\n<include file="$(dirname)/inc.launch"/>')
+    assert info.value.location.file.endswith("inc.launch") and info.value.location.line == 2
+    assert "included from" in str(info.value) and "main.launch:3" in str(info.value)

@@ -677,8 +677,13 @@ class Interpreter:
         root = self._parse(filename)
         child.include_stack = (*scope.include_stack, key)
         self.files.append(filename)
-        self._check_launch_tag(root, child)
-        result = self._children(root.children, child, default_machine)
+        try:
+            self._check_launch_tag(root, child)
+            result = self._children(root.children, child, default_machine)
+        except LaunchError as exc:
+            # keep the inner location; say how the file was reached
+            raise LaunchError(f"{exc.message} (included from {entity.location})",
+                              exc.location) from None
         if not pass_all:
             unused = child.unused_include_args()
             if unused:
