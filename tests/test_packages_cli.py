@@ -235,3 +235,12 @@ def test_pkg_plugins_lists_exports_of_packages_depending_on_the_tool(env, tmp_pa
     proc = cli("pkg", "plugins", "tool", cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.splitlines() == [f"user {user}/plugins.xml"]
+
+
+def test_pkg_roots_and_which_show_search_path_and_resolved_executable(env, tmp_path):
+    pkg = package(env, "whiched")
+    exe = script(pkg / "nodes" / "thing")
+    roots = cli("pkg", "roots", cwd=tmp_path).stdout.splitlines()
+    assert roots[0] == f"{env} [ROS_PACKAGE_PATH]"
+    assert roots[-1].endswith("[bundled]")
+    assert cli("pkg", "which", "whiched", "thing", cwd=tmp_path).stdout.strip() == str(exe)
