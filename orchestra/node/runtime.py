@@ -219,8 +219,10 @@ class NodeRuntime:
     def bus_stats(self) -> list:
         pubs, subs = self.topics.bus_stats()
         with self._services_lock:
-            calls = sum(s.calls for s in self.services.values())
-        return [pubs, subs, [0, calls, 0]]
+            servers = list(self.services.values())
+        # ROS: serviceStats = [numRequests, bytesReceived, bytesSent]
+        return [pubs, subs, [sum(s.calls for s in servers), sum(s.bytes_in for s in servers),
+                             sum(s.bytes_out for s in servers)]]
 
     def bus_info(self) -> list:
         return self.topics.bus_info()

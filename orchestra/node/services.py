@@ -54,6 +54,8 @@ class ServiceServer:
         self.srv_class = srv_class
         self.handler = handler
         self.calls = 0
+        self.bytes_in = 0
+        self.bytes_out = 0
         self.closed = False
         self.sockets: set[socket.socket] = set()
         self.lock = threading.Lock()
@@ -115,6 +117,8 @@ class ServiceServer:
                                          f"error processing request: {exc}".encode("utf-8"))
             return
         self.calls += 1
+        self.bytes_in += len(data) + 4
+        self.bytes_out += len(body) + 5
         tcpros.send_service_response(sock, True, body)
 
     def close(self) -> None:

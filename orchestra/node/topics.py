@@ -604,7 +604,7 @@ class TopicManager:
             for topic, pub in self.publications.items():
                 conns = [[c.id, c.bytes_sent, c.messages_sent, not c.closed]
                          for c in list(pub.connections)]
-                pubs.append([topic, pub.messages, conns])
+                pubs.append([topic, sum(c[1] for c in conns), conns])
             for topic, sub in self.subscriptions.items():
                 conns = [[c.id, c.bytes_received, c.drops, c.connected]
                          for c in list(sub.connections.values())]
