@@ -22,7 +22,7 @@ from typing import Any, Callable
 from orchestra.errors import Location, OrchestraError
 from orchestra.launch.context import Scope, ScopeError
 from orchestra.launch.entity import Entity
-from orchestra.launch.files import read_text
+from orchestra.launch.files import read_bytes, read_text
 from orchestra.launch.plan import LaunchPlan, Machine, Node, Test
 from orchestra.launch.substitution import ArgNotSet, SubstitutionError, resolve
 from orchestra.launch.values import bool_attribute, convert_value, float_attribute
@@ -393,40 +393,35 @@ class Interpreter:
 
     def _param_value(self, entity: Entity, name: str, ptype: str, source: str, raw: str
                      ) -> Any:
+        if source == "value":
+            return self._convert(entity, raw.strip(), ptype, source)
+        if source == "textfile":
+            try:
+                text = read_text(raw)
+            except (OSError, UnicodeDecodeError) as exc:
+                raise self._error(entity, f"cannot read [{raw}]: {exc}", "textfile") from None
+            return self._convert(entity, text, ptype, source)
+        if source == "binfile":
+            try:
+                return Binary(read_bytes(raw))
+            except OSError as exc:
+                raise self._error(entity, f"cannot read [{raw}]: {exc}", "binfile") from None
+        if self.options.no_exec:
+            return {"__command__": raw}
+        return self._convert(entity, self._run_command(entity, name, raw), ptype, source)
+
+    def _convert(self, entity: Entity, text: str, ptype: str, source: str) -> Any:
+        """``text`` typed by ``ptype``; a bad value or bad YAML is an error at the tag."""
+        from orchestra.params.yaml import RosparamYamlError
         try:
-            if source == "value":
-                if ptype == "yaml":
-                    return self._yaml_value(entity, raw.strip())
-                return convert_value(raw.strip(), ptype)
-            if source == "textfile":
-                try:
-                    with open(raw, "r", encoding="utf-8") as fh:
-                        text = fh.read()
-                except OSError as exc:
-                    raise self._error(entity, f"cannot read [{raw}]: {exc.strerror}",
-                                      "textfile") from None
-                return convert_value(text, ptype)
-            if source == "binfile":
-                try:
-                    with open(raw, "rb") as fh:
-                        return Binary(fh.read())
-                except OSError as exc:
-                    raise self._error(entity, f"cannot read [{raw}]: {exc.strerror}",
-                                      "binfile") from None
-            if self.options.no_exec:
-                return {"__command__": raw}
-            return convert_value(self._run_command(entity, name, raw), ptype)
-        except OrchestraError:
-            raise
+            if ptype == "yaml":
+                from orchestra.params.yaml import load_yaml_value
+                return load_yaml_value(text, entity.location.file)
+            return convert_value(text, ptype)
+        except RosparamYamlError as exc:
+            raise self._error(entity, exc.message, source) from None
         except ValueError as exc:
             raise self._error(entity, str(exc), "type" if ptype != "auto" else source) from None
-
-    def _yaml_value(self, entity: Entity, text: str) -> Any:
-        from orchestra.params.yaml import RosparamYamlError, load_yaml_value
-        try:
-            return load_yaml_value(text, entity.location.file)
-        except RosparamYamlError as exc:
-            raise self._error(entity, exc.message, "value") from None
 
     def _run_command(self, entity: Entity, name: str, command: str) -> str:
         """roslaunch runs ``command=`` at load time, shell-split but without a shell."""
