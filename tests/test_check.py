@@ -20,6 +20,10 @@ def ws(tmp_path, monkeypatch):
     (pkg / "config").mkdir()
     (pkg / "package.xml").write_text("<package><name>mypkg</name></package>\n")
     (pkg / "config" / "gains.yaml").write_text("p: 1.0\n")
+    (pkg / "scripts").mkdir()
+    for exe in ("t", "x", "y"):
+        (pkg / "scripts" / exe).write_text("#!/bin/sh\n")
+        (pkg / "scripts" / exe).chmod(0o755)
     monkeypatch.setenv("ROS_PACKAGE_PATH", str(tmp_path / "ws"))
     return pkg
 
@@ -129,13 +133,43 @@ def test_missing_package_is_an_error_in_a_taken_branch_and_a_warning_otherwise(w
                  '  <include if="$(arg sim)" file="$(find gazebo_nowhere)/x.launch"/>\n'
                  '</launch>\n')
     report = check_files([path])
-    by_line = {p.location.line: p for p in report.problems if p.code == "missing-package"}
+    by_line = {p.location.line: p for p in report.problems
+               if p.code in ("missing-package", "missing-node")}
     assert by_line[3].severity == ERROR and "'nopkg'" in by_line[3].message
     assert by_line[4].severity == WARNING and "not take" in by_line[4].message
     assert report.errors  # the node's package really is missing
     with_sim = check_files([path], {"sim": "true"})
     assert [p.severity for p in with_sim.problems
             if p.code == "missing-package" and p.location.line == 4] == [ERROR]
+
+
+def test_node_executable_that_the_package_lacks_is_reported(ws):
+    path = write(ws / "launch", "a.launch",
+                 '<launch>\n  <node pkg="mypkg" type="nonexistent" name="n"/>\n</launch>\n')
+    problem = only(check_files([path]), "missing-node")
+    assert problem.severity == ERROR and "nonexistent" in problem.message
+    assert (problem.location.line, problem.location.column) == (2, 21)
+
+
+def test_substitution_that_can_never_resolve_is_reported_in_every_branch(ws):
+    path = write(ws / "launch", "a.launch",
+                 '<launch>\n  <param name="a" value="$(fnd mypkg)"/>\n'
+                 '  <group if="false">\n    <param name="b" value="$(arg)"/>\n'
+                 '    <param name="c" value="$(eval 1 +)"/>\n  </group>\n</launch>\n')
+    report = check_files([path])
+    found = {p.location.line: p for p in report.problems if p.code == "bad-substitution"}
+    assert sorted(found) == [2, 4, 5]
+    assert found[2].severity == ERROR and "did you mean 'find'" in found[2].message
+    assert found[4].severity == WARNING and "takes 1 argument" in found[4].message
+    assert "not a valid expression" in found[5].message
+
+
+def test_missing_required_attribute_in_an_untaken_branch_is_a_warning(ws):
+    path = write(ws / "launch", "a.launch",
+                 '<launch>\n  <group if="false">\n    <node pkg="mypkg" type="t"/>\n'
+                 '  </group>\n</launch>\n')
+    problem = only(check_files([path]), "missing-attribute")
+    assert problem.severity == WARNING and "'name'" in problem.message
 
 
 def test_missing_rosparam_and_textfile_files_are_reported(ws):
@@ -226,7 +260,7 @@ def test_yaml_conversion_has_the_same_problems_as_the_xml(ws):
                      '  <param name="a" value="$(arg nope)"/>\n  <nod/>\n</launch>\n')
     yaml_path = write(ws / "launch", "a.launch.yaml", convert_file(xml_path, "yaml"))
     assert codes(check_files([yaml_path])) == codes(check_files([xml_path]))
-    assert codes(check_files([xml_path])) == ["missing-package", "respawn-required",
+    assert codes(check_files([xml_path])) == ["missing-node", "respawn-required",
                                               "undeclared-arg", "unknown-tag", "unused-arg"]
 
 
@@ -278,7 +312,8 @@ def test_cli_missing_file_is_reported_not_a_traceback(tmp_path):
 @pytest.mark.timeout(120)
 def test_check_flags_every_smoke_file_roslaunch_rejects(compat_dir, monkeypatch):
     """Each of the smoke files roslaunch refuses gets at least one error from check; the
-    files it loads get none except missing packages (the corpus ships no node packages)."""
+    files it loads get none except missing node packages/executables (the corpus ships no
+    code)."""
     monkeypatch.setenv("ROS_PACKAGE_PATH", str(compat_dir / "ws"))
     monkeypatch.setenv("ROS_DISTRO", "noetic")
     for var in ("ROS_NAMESPACE", "HOME", "DISPLAY"):
@@ -287,8 +322,9 @@ def test_check_flags_every_smoke_file_roslaunch_rejects(compat_dir, monkeypatch)
     missed, false_alarms = [], []
     for item in smoke:
         report = check_files([str(compat_dir / "ws" / item["launch_file"])])
-        errors = [p for p in report.errors if p.code != "missing-package"]
-        if not item["ok"] and not report.errors:
+        errors = [p for p in report.errors
+                  if p.code not in ("missing-node",)]
+        if not item["ok"] and not errors:  # roslaunch refuses to load, not to run
             missed.append(item["launch_file"])
         if item["ok"] and any(p.code not in ("unknown-tag",) for p in errors):
             false_alarms.append((item["launch_file"], [str(p) for p in errors]))
@@ -299,7 +335,7 @@ def test_check_flags_every_smoke_file_roslaunch_rejects(compat_dir, monkeypatch)
 @pytest.mark.timeout(120)
 def test_compat_cases_have_no_errors_but_missing_node_packages(compat_dir, monkeypatch):
     """roslaunch loads all 80 cases with their args and env: check must not call any of them
-    broken, except for node packages the corpus does not ship."""
+    broken, except for node packages and executables the corpus does not ship."""
     from orchestra.names import load_mappings
 
     cases = json.loads((compat_dir / "cases.json").read_text())
@@ -315,7 +351,8 @@ def test_compat_cases_have_no_errors_but_missing_node_packages(compat_dir, monke
                 env.setenv(name, value)
             args = load_mappings([f"{k}:={v}" for k, v in case["args"].items()])
             report = check_files([str(compat_dir / "ws" / case["launch_file"])], args)
-        false_alarms += [str(p) for p in report.errors if p.code != "missing-package"]
+        false_alarms += [str(p) for p in report.errors
+                         if p.code not in ("missing-node",)]
     assert false_alarms == []
 
 

@@ -76,6 +76,27 @@ def _tag_rules() -> tuple[dict[str, frozenset[str]], dict[str, tuple[str, ...]]]
     return attributes, children
 
 
+# Attributes without which the interpreter rejects an element. The interpreter states these
+# in code (``_req``), not as data; repeated here so that elements in branches the args do not
+# take, which the interpreter never reaches, are checked too.
+REQUIRED_ATTRIBUTES: dict[str, tuple[str, ...]] = {
+    "node": ("pkg", "type", "name"),
+    "test": ("pkg", "type", "test-name"),
+    "param": ("name",),
+    "remap": ("from", "to"),
+    "include": ("file",),
+    "arg": ("name",),
+    "env": ("name", "value"),
+    "machine": ("name", "address"),
+}
+
+# Static findings the interpreter also raises when it reaches the element: an interpreter
+# error on the same line as one of these is the same problem, already reported with its column.
+_ALSO_FOUND_BY_INTERPRETER = frozenset({
+    "syntax", "missing-package", "missing-file", "include-cycle", "respawn-required",
+    "if-unless", "bad-substitution", "missing-attribute", "undeclared-arg",
+})
+
 # Names an ``$(eval ...)`` expression may use that are not args.
 _EVAL_NAMES = frozenset({"arg", "env", "optenv", "find", "anon", "dirname", "true", "false",
                          "True", "False", "None"}) | frozenset(dir(builtins))
@@ -349,6 +370,8 @@ class Checker:
         includes: list[_Include] = []
         for entity, parent, taken in self._walk(root, None, scope, True):
             self._check_tag(entity, parent)
+            self._check_required(entity, taken)
+            self._check_substitutions(entity, taken)
             for name, value in entity.attributes.items():
                 used.update(_arg_references(value))
             if entity.text and entity.tag == "rosparam":
@@ -415,6 +438,28 @@ class Checker:
         if entity.has("if") and entity.has("unless"):
             self._problem(ERROR, self.sources.locate(entity, "unless"),
                           f"<{entity.tag}> has both 'if' and 'unless'", "if-unless")
+
+    def _check_required(self, entity: Entity, taken: bool) -> None:
+        missing = [a for a in REQUIRED_ATTRIBUTES.get(entity.tag, ()) if not entity.has(a)]
+        if missing:
+            severity, note = self._severity(taken)
+            names = ", ".join(f"'{a}'" for a in missing)
+            self._problem(severity, self.sources.locate(entity),
+                          f"<{entity.tag}> is missing required attribute(s) {names}{note}",
+                          "missing-attribute")
+
+    def _check_substitutions(self, entity: Entity, taken: bool) -> None:
+        """``$(...)`` that can never resolve: unknown command, wrong word count, bad eval."""
+        values = list(entity.attributes.items())
+        if entity.tag == "rosparam" and entity.text and _is_true(
+                entity.get("subst_value") or "") is True:
+            values.append(("subst_value", entity.text))
+        for name, value in values:
+            problem = _substitution_problem(value)
+            if problem:
+                severity, note = self._severity(taken)
+                self._problem(severity, self.sources.locate(entity, name),
+                              f"attribute '{name}': {problem}{note}", "bad-substitution")
 
     # ---------------------------------------------------------------- args
     def _check_args(self, path: str, declared: dict[str, Entity], used: set[str],
@@ -492,16 +537,7 @@ class Checker:
         for name, value in entity.attributes.items():
             packages_ok &= self._check_packages(entity, name, value, taken)
         if entity.tag in ("node", "test"):
-            pkg = entity.get("pkg")
-            if pkg and "$" not in pkg:
-                from orchestra.packages import PackageNotFound, find_package
-
-                try:
-                    find_package(pkg)
-                except PackageNotFound:
-                    severity, note = self._severity(taken)
-                    self._problem(severity, self.sources.locate(entity, "pkg"),
-                                  f"package '{pkg}' not found{note}", "missing-package")
+            self._check_executable(entity, scope, taken)
         if not packages_ok:
             return
         file_attributes = {"rosparam": ("file",), "param": ("textfile", "binfile")}
@@ -514,6 +550,29 @@ class Checker:
                 severity, note = self._severity(taken)
                 self._problem(severity, self.sources.locate(entity, name),
                               f"{name} '{path}' does not exist{note}", "missing-file")
+
+    def _check_executable(self, entity: Entity, scope: _StaticScope, taken: bool) -> None:
+        """The node's package exists and holds exactly one executable of that name."""
+        from orchestra.packages import PackageNotFound, find_executable, find_package
+
+        pkg = _try_resolve(entity.get("pkg"), scope)
+        exe = _try_resolve(entity.get("type"), scope)
+        if not pkg:
+            return
+        severity, note = self._severity(taken)
+        try:
+            find_package(pkg)
+        except PackageNotFound:
+            self._problem(severity, self.sources.locate(entity, "pkg"),
+                          f"<{entity.tag}> package '{pkg}' not found{note}", "missing-node")
+            return
+        if not exe:
+            return
+        try:
+            find_executable(pkg, exe)
+        except OrchestraError as exc:
+            self._problem(severity, self.sources.locate(entity, "type"), exc.message + note,
+                          "missing-node")
 
     def _check_node_flags(self, entity: Entity, scope: _StaticScope) -> None:
         if entity.tag != "node":
@@ -581,7 +640,8 @@ class Checker:
             interp.load_file(path)
         except OrchestraError as exc:  # the root itself (already reported as syntax)
             interp.errors.append(exc)
-        static_lines = {(p.location.file, p.location.line) for p in self.report.problems}
+        static_lines = {(p.location.file, p.location.line) for p in self.report.problems
+                        if p.code in _ALSO_FOUND_BY_INTERPRETER}
         for exc in interp.errors:
             where = exc.location or Location(path)
             if (where.file, where.line) in static_lines:
@@ -589,8 +649,7 @@ class Checker:
             self._problem(ERROR, self._precise(where, exc.message), exc.message, "launch")
         for entity, message in interp.warned:
             where = self.sources.locate(entity)
-            if (where.file, where.line) in static_lines or "unknown <" in message \
-                    or "unrecognized" in message:
+            if "unknown <" in message or "unrecognized" in message:
                 continue  # unknown tags/attributes: the static pass reports them, located
             self._problem(WARNING, where, message, "launch")
         self._check_plan(interp.plan())
@@ -671,6 +730,40 @@ class _CollectingInterpreterProxy:
 
 
 _CollectingInterpreter = _CollectingInterpreterProxy()
+
+
+def _substitution_problem(value: str) -> str | None:
+    """Why ``value``'s substitutions can never resolve, or None (unset args/env are fine
+    here: they depend on how the file is launched)."""
+    if "$" not in value:
+        return None
+    stripped = value.strip()
+    if value.startswith("$(eval ") and value.endswith(")"):
+        try:
+            ast.parse(stripped[7:-1].strip(), mode="eval")
+        except SyntaxError as exc:
+            return f"$(eval) is not a valid expression: {exc.msg}"
+        return None
+    try:
+        bodies = substitution.collect(value)
+    except OrchestraError as exc:
+        return exc.message
+    arity = {"find": 1, "env": 1, "anon": 1, "arg": 1, "dirname": 0}
+    for body in bodies:
+        words = body.split()
+        if not words or words[0] not in substitution.COMMANDS:
+            command = words[0] if words else ""
+            hint = _suggest(command, substitution.COMMANDS) if command else ""
+            return (f"unknown substitution $({body}){hint}; valid: "
+                    f"{', '.join(substitution.COMMANDS)} (and a whole-value $(eval ...))")
+        if words[0] == "eval":
+            return "$(eval ...) must be the whole value"
+        expected = arity.get(words[0])
+        if expected is not None and len(words) - 1 != expected:
+            return f"$({words[0]}) takes {expected} argument(s): $({body})"
+        if words[0] == "optenv" and len(words) < 2:
+            return f"$(optenv) needs a variable name: $({body})"
+    return None
 
 
 def _suggest(name: str, known: Any) -> str:
