@@ -6,6 +6,14 @@ import pytest
 
 from orchestra.node.msg import get_message_class, get_service_class
 
+
+@pytest.fixture(autouse=True)
+def bundled_packages_only(monkeypatch):
+    # the definitions must come from orchestra's packages/turtlesim, not a ROS workspace
+    for key in ("ROS_PACKAGE_PATH", "CMAKE_PREFIX_PATH"):
+        monkeypatch.delenv(key, raising=False)
+
+
 ROS_MD5 = {
     "turtlesim/Pose": "863b248d5016ca62ea2e895ae5265cf9",
     "turtlesim/Color": "353891e354491c51aabe32df673fb446",
