@@ -5,6 +5,7 @@ Waits for ``~service`` (default ``mobile_base/set_digital_outputs``, kobuki_msgs
 SetDigitalOutputs) up to ``~timeout`` seconds (default 30) and sets output ``~output``
 (default 1) on. Exits 1 when the base never offers the service or refuses.
 """
+import os
 import sys
 
 
@@ -42,4 +43,11 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from orchestra.node import ROSException, ROSInterruptException
+    try:
+        sys.exit(main())
+    except ROSInterruptException:
+        sys.exit(0)
+    except ROSException as exc:  # e.g. no master to talk to: one line, not a traceback
+        sys.stderr.write(f"{os.path.basename(sys.argv[0])}: {exc}\n")
+        sys.exit(1)

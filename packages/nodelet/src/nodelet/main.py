@@ -169,6 +169,7 @@ def run_unload(nodelet_name: str, manager_name: str) -> int:
 
 def main(argv: list[str] | None = None) -> int:
     from orchestra.errors import OrchestraError
+    from orchestra.node import ROSException, ROSInterruptException
 
     argv = sys.argv[1:] if argv is None else argv
     words = names.strip_ros_args(argv)
@@ -188,5 +189,10 @@ def main(argv: list[str] | None = None) -> int:
     except OrchestraError as exc:
         sys.stderr.write(f"nodelet: error: {exc}\n")
         return exc.exit_code
+    except ROSInterruptException:
+        return 0
+    except ROSException as exc:  # e.g. no master to talk to: one line, not a traceback
+        sys.stderr.write(f"nodelet: {exc}\n")
+        return 1
     sys.stderr.write(USAGE + "\n")
     return 2
