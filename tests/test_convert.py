@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -104,7 +105,8 @@ def resolved(path: str, words: list[str], converted: dict[str, str]) -> str:
         plan = load_launch(path, load_mappings(words), no_exec=True)
         text = json.dumps(plan.to_json(), default=binary_to_json, sort_keys=True)
     except OrchestraError as exc:
-        text = "error: " + exc.message
+        # same error, but lines and columns differ between a file and its conversion
+        text = "error: " + re.sub(r"(\.\w+):\d+(?::\d+)?", r"\1", exc.message)
     for target in sorted(converted, key=len, reverse=True):
         text = text.replace(target, converted[target])
     return text
