@@ -48,6 +48,14 @@ def test_topic_echo_prints_yaml_documents_each_followed_by_dashes(nodes):
     assert result.stdout == 'data: "hello"\n---\ndata: "hello"\n---\n'
 
 
+def test_topic_echo_of_a_field_path_prints_just_that_field(nodes):
+    nodes.start("pub.py", "turtle1/pose", "geometry_msgs/Pose2D", "{x: 5.5, y: 1, theta: 0}"
+                ).ready()
+    result = orchestra(nodes, "topic", "echo", "/turtle1/pose/x", "-n", "1")
+    assert result.returncode == 0, result.stderr
+    assert result.stdout == "5.5\n---\n"
+
+
 def test_topic_echo_decodes_a_type_it_has_no_definition_for(nodes, package_path):
     nodes.start("pub.py", "nums", "test_msgs/Num", "{num: 4, label: four}").ready()
     env_without_pkg = dict(nodes.env, ROS_PACKAGE_PATH="")

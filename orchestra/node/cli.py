@@ -280,6 +280,7 @@ def topic_echo(name: str, count: int | None, noarr: bool) -> None:
     printed = 0
     try:
         state = introspect.system_state(_master_uri())
+        name, fields = split_field_path(name, state.topics)
         if name not in state.publishers:
             click.echo(f"WARNING: topic [{name}] does not appear to be published yet", err=True)
         _sub, inbox = _subscribe_raw(rospy, name)
@@ -289,7 +290,9 @@ def topic_echo(name: str, count: int | None, noarr: bool) -> None:
             except queue.Empty:
                 continue
             msg = decode(raw)
-            if noarr:
+            if fields:
+                msg = pick_field(msg, fields)
+            if noarr and hasattr(msg, "_fields"):
                 for field_name in msg._fields:
                     value = getattr(msg, field_name)
                     if isinstance(value, (list, tuple, bytes)):
@@ -300,6 +303,32 @@ def topic_echo(name: str, count: int | None, noarr: bool) -> None:
         pass
     finally:
         _stop_cli_node("topic echo done")
+
+
+def split_field_path(name: str, topics: list[str]) -> tuple[str, list[str]]:
+    """``/turtle1/pose/x`` -> (``/turtle1/pose``, ``["x"]``) when only the prefix is a topic
+    (rostopic echo's field selection); a name that is a topic is returned whole."""
+    if name in topics:
+        return name, []
+    parts = name.split("/")
+    for cut in range(len(parts) - 1, 1, -1):
+        prefix = "/".join(parts[:cut])
+        if prefix in topics:
+            return prefix, parts[cut:]
+    return name, []
+
+
+def pick_field(msg, fields: list[str]):
+    value = msg
+    for f in fields:
+        if isinstance(value, (list, tuple)) and f.isdigit() and int(f) < len(value):
+            value = value[int(f)]
+        elif hasattr(value, "_fields") and f in value._fields:
+            value = getattr(value, f)
+        else:
+            raise OrchestraError(f"{getattr(msg, '_type', 'message')} has no field "
+                                 f"{'/'.join(fields)}")
+    return value
 
 
 @topic.command("pub")

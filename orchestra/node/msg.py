@@ -390,9 +390,10 @@ def _strify(value: Any, indent: str, slot_type: str = "") -> str:
     return str(value)
 
 
-def to_yaml_text(msg: Message) -> str:
-    """The message as ``rostopic echo`` prints it (genpy's layout, e.g. ``nsecs`` width 9)."""
-    return _strify(msg, "")
+def to_yaml_text(msg: Any) -> str:
+    """A message (or one field's value) as ``rostopic echo`` prints it (genpy's layout,
+    e.g. ``nsecs`` right-aligned to width 9)."""
+    return _strify(msg, "").lstrip("\n")
 
 
 class FillError(ROSException):
