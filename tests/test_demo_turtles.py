@@ -20,6 +20,10 @@ from pathlib import Path
 
 import pytest
 
+# orchestra's bundled packages, whatever ROS workspace the developer's shell points at
+BUNDLED_ENV = {k: v for k, v in os.environ.items()
+               if k not in ("ROS_PACKAGE_PATH", "CMAKE_PREFIX_PATH")}
+
 REPO = Path(__file__).resolve().parent.parent
 PEN = (179, 184, 255)
 PX_PER_METER = 45.0
@@ -71,7 +75,7 @@ class Launch:
 
     def __init__(self, tmp_path: Path, *words: str):
         self.uri = f"http://127.0.0.1:{free_port()}/"
-        self.env = dict(os.environ, ROS_MASTER_URI=self.uri, ROS_HOME=str(tmp_path / "ros_home"),
+        self.env = dict(BUNDLED_ENV, ROS_MASTER_URI=self.uri, ROS_HOME=str(tmp_path / "ros_home"),
                         PYTHONUNBUFFERED="1")
         self.env.pop("DISPLAY", None)  # headless whatever the developer's session has
         self.env.pop("ROS_NAMESPACE", None)

@@ -16,6 +16,10 @@ import pytest
 from orchestra.tf.drawing import layout, tree_dot, tree_svg
 from orchestra.tf.transformations import euler_from_quaternion
 
+# orchestra's bundled packages, whatever ROS workspace the developer's shell points at
+BUNDLED_ENV = {k: v for k, v in os.environ.items()
+               if k not in ("ROS_PACKAGE_PATH", "CMAKE_PREFIX_PATH")}
+
 SCRIPTS = Path(__file__).resolve().parent.parent / "packages" / "tf" / "scripts"
 
 
@@ -65,7 +69,7 @@ def test_static_publisher_rejects_bad_arguments(stp, args):
 def test_static_publisher_bad_arguments_exit_1_with_usage_and_no_traceback():
     proc = subprocess.run([str(SCRIPTS / "static_transform_publisher"), "1", "2"],
                           capture_output=True, text=True, timeout=30,
-                          env=dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:1/"))
+                          env=dict(BUNDLED_ENV, ROS_MASTER_URI="http://127.0.0.1:1/"))
     assert proc.returncode == 1
     assert "usage" in proc.stderr and "Traceback" not in proc.stderr
 
@@ -103,7 +107,7 @@ def master():
 
 @pytest.mark.timeout(60)
 def test_static_transform_reaches_tf_echo_and_view_frames(master, tmp_path):
-    env = dict(os.environ, ROS_MASTER_URI=master, PYTHONUNBUFFERED="1")
+    env = dict(BUNDLED_ENV, ROS_MASTER_URI=master, PYTHONUNBUFFERED="1")
     procs = []
     try:
         procs.append(subprocess.Popen(

@@ -12,6 +12,10 @@ import pytest
 
 from test_turtlesim_world import read_png
 
+# orchestra's bundled packages, whatever ROS workspace the developer's shell points at
+BUNDLED_ENV = {k: v for k, v in os.environ.items()
+               if k not in ("ROS_PACKAGE_PATH", "CMAKE_PREFIX_PATH")}
+
 SCRIPTS = Path(__file__).resolve().parent.parent / "packages" / "turtlesim" / "scripts"
 PEN = (179, 184, 255)
 CENTRE = (500 - 1) / 45.0 / 2
@@ -27,7 +31,7 @@ def master():
 
 @pytest.mark.timeout(60)
 def test_draw_square_draws_the_first_two_sides_from_the_centre(master, tmp_path):
-    env = dict(os.environ, ROS_MASTER_URI=master)
+    env = dict(BUNDLED_ENV, ROS_MASTER_URI=master)
     env.pop("DISPLAY", None)
     png = tmp_path / "square.png"
     procs = [subprocess.Popen([str(SCRIPTS / "turtlesim_node"), f"_snapshot:={png}"], env=env,

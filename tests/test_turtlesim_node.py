@@ -13,6 +13,10 @@ import pytest
 
 from test_turtlesim_world import read_png
 
+# orchestra's bundled packages, whatever ROS workspace the developer's shell points at
+BUNDLED_ENV = {k: v for k, v in os.environ.items()
+               if k not in ("ROS_PACKAGE_PATH", "CMAKE_PREFIX_PATH")}
+
 SIM = Path(__file__).resolve().parent.parent / "packages" / "turtlesim" / "scripts" / \
     "turtlesim_node"
 
@@ -72,7 +76,7 @@ def master():
 
 @pytest.mark.timeout(90)
 def test_turtlesim_node_services_topics_walls_and_snapshots(master, tmp_path):
-    env = dict(os.environ, ROS_MASTER_URI=master, PYTHONUNBUFFERED="1")
+    env = dict(BUNDLED_ENV, ROS_MASTER_URI=master, PYTHONUNBUFFERED="1")
     env.pop("DISPLAY", None)
     sim = subprocess.Popen([str(SIM), "__name:=sim"], env=env, stdout=subprocess.DEVNULL,
                            stderr=subprocess.DEVNULL)
@@ -119,7 +123,7 @@ print(m.x)
 
 @pytest.mark.timeout(60)
 def test_gui_requested_on_an_unusable_display_falls_back_to_headless(master):
-    env = dict(os.environ, ROS_MASTER_URI=master, DISPLAY=":987", PYTHONUNBUFFERED="1")
+    env = dict(BUNDLED_ENV, ROS_MASTER_URI=master, DISPLAY=":987", PYTHONUNBUFFERED="1")
     sim = subprocess.Popen([str(SIM), "_gui:=true"], env=env, stdout=subprocess.PIPE,
                            stderr=subprocess.STDOUT, text=True)
     try:

@@ -13,6 +13,10 @@ from pathlib import Path
 
 import pytest
 
+# orchestra's bundled packages, whatever ROS workspace the developer's shell points at
+BUNDLED_ENV = {k: v for k, v in os.environ.items()
+               if k not in ("ROS_PACKAGE_PATH", "CMAKE_PREFIX_PATH")}
+
 SCRIPTS = Path(__file__).resolve().parent.parent / "packages" / "turtlesim" / "scripts"
 
 READ_X = r'''
@@ -51,7 +55,7 @@ def turtle_x(env: dict) -> float:
 
 @pytest.mark.timeout(60)
 def test_teleop_without_a_terminal_exits_zero_with_a_reason(master):
-    env = dict(os.environ, ROS_MASTER_URI=master)
+    env = dict(BUNDLED_ENV, ROS_MASTER_URI=master)
     proc = subprocess.run([str(SCRIPTS / "turtle_teleop_key")], env=env, stdin=subprocess.DEVNULL,
                           capture_output=True, text=True, timeout=30)
     assert proc.returncode == 0
@@ -60,7 +64,7 @@ def test_teleop_without_a_terminal_exits_zero_with_a_reason(master):
 
 @pytest.mark.timeout(60)
 def test_teleop_up_arrow_in_a_terminal_moves_turtle1_forward_and_q_quits(master):
-    env = dict(os.environ, ROS_MASTER_URI=master, PYTHONUNBUFFERED="1")
+    env = dict(BUNDLED_ENV, ROS_MASTER_URI=master, PYTHONUNBUFFERED="1")
     env.pop("DISPLAY", None)
     sim = subprocess.Popen([str(SCRIPTS / "turtlesim_node")], env=env,
                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
