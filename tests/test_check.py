@@ -368,3 +368,28 @@ def test_cli_directory_checks_included_files_through_their_includer(ws):
     assert [line.split(":")[0] for line in proc.stdout.splitlines()] == \
         [str(ws / "launch" / "broken.launch")]
     assert "2 file(s) checked" in proc.stderr
+
+
+@pytest.mark.timeout(120)
+def test_check_flags_every_roslaunch_fixture_roslaunch_rejects(compat_dir, monkeypatch):
+    """roslaunch's own test fixtures: each one it rejects gets an error from check. The ones
+    it accepts get none, except elements it silently drops (its 'valid' fixtures contain a
+    <fake> tag on purpose): check is stricter there by design."""
+    fixtures = compat_dir / "fixtures"
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(fixtures / "ws"))
+    monkeypatch.setenv("ROS_DISTRO", "noetic")
+    missed, false_alarms = [], []
+    for expected in sorted((fixtures / "expected").glob("*.json")):
+        outcome = json.loads(expected.read_text())
+        matches = [p for p in (fixtures / "ws/roslaunch/test/xml").glob(expected.stem + ".*")
+                   if p.is_file()]
+        if not matches:
+            continue  # a fixture directory's helper file, checked through its includer
+        report = check_files([str(matches[0])])
+        errors = [p for p in report.errors if p.code != "missing-node"]
+        if not outcome["ok"] and not errors:
+            missed.append(expected.stem)
+        if outcome["ok"] and any(p.code != "unknown-tag" for p in errors):
+            false_alarms.append([str(p) for p in errors])
+    assert missed == []
+    assert false_alarms == []
