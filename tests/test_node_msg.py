@@ -183,6 +183,10 @@ def test_fill_message_from_yaml_shapes():
     assert fill_message(String(), "hello").data == "hello"
     Header = get_message_class("std_msgs/Header")
     assert fill_message(Header(), {"stamp": {"secs": 1, "nsecs": 2}}).stamp == Time(1, 2)
+    Stamped = get_message_class("geometry_msgs/PointStamped")
+    stamped = fill_message(Stamped(), {"header": "auto", "point": {"x": 1}})
+    assert stamped.header.stamp.secs > 0
+    assert fill_message(Stamped(), {"header": {"stamp": "now"}}).header.stamp.secs > 0
     with pytest.raises(FillError, match="no field linear.w"):
         fill_message(Twist(), {"linear": {"w": 1}})
     with pytest.raises(FillError, match="must be a number"):

@@ -76,6 +76,16 @@ def test_topic_pub_once_reaches_a_running_subscriber(nodes):
                               "angular": {"x": 0.0, "y": 0.0, "z": 1.0}}
 
 
+def test_topic_pub_without_rate_latches_and_stays_up_for_late_subscribers(nodes):
+    pub = nodes.start_orchestra("topic", "pub", "/greeting", "std_msgs/String", "hello")
+    pub.expect(lambda d: "publishing and latching" in d.get("text", ""))
+    sub = nodes.start("sub.py", "greeting", "std_msgs/String")
+    assert sub.expect(lambda d: "msg" in d) == {"msg": {"data": "hello"}, "latching": "1"}
+    assert pub.proc.poll() is None
+    pub.signal(2)
+    assert pub.wait() == 0
+
+
 def test_topic_pub_at_a_rate_streams_messages(nodes):
     sub = nodes.start("sub.py", "ticks", "std_msgs/Int32")
     sub.ready()

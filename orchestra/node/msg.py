@@ -448,6 +448,11 @@ def _fill_field(current: Any, value: Any, base: str, array: int | None, path: st
         if isinstance(value, bool) or not isinstance(value, int):
             raise FillError(f"field {path} must be an integer, not {value!r}")
         return value
+    if base == "std_msgs/Header" and value == "auto":
+        # rostopic pub's substitution: a header stamped now
+        header = get_message_class(base)()
+        header.stamp = Time.now()
+        return header
     return fill_message(current if isinstance(current, Message) else get_message_class(base)(),
                         value, path)
 
