@@ -355,3 +355,9 @@ def test_two_nodes_with_one_name_are_a_user_error(run_env):
         run_plan(plan, OPTS)
     assert str(info.value).startswith("a.launch:5: ") and "a.launch:1" in str(info.value)
     assert not (run_env["out"] / "twin.json").exists()
+
+
+def test_node_path_puts_orchestras_interpreter_first_when_missing():
+    from orchestra.supervise.runner import path_with_interpreter
+    assert path_with_interpreter("/usr/bin:/bin", "/venv/bin/python3") == "/venv/bin:/usr/bin:/bin"
+    assert path_with_interpreter("/usr/bin:/venv/bin", "/venv/bin/python3") == "/usr/bin:/venv/bin"

@@ -13,12 +13,22 @@ index can key its in-process cache on the result.
 from __future__ import annotations
 
 import os
+import sys
 from dataclasses import dataclass
 from typing import Mapping
 
 #: orchestra's own demo packages: ``packages/`` at the repository root
-BUNDLED_PACKAGES = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(
-    os.path.abspath(__file__)))), "packages")
+def _bundled_packages_dir() -> str:
+    """The demo packages shipped with orchestra: the repository's ``packages/`` in a source or
+    editable install, else the copy a wheel installs under ``<prefix>/share/orchestra``."""
+    source = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(
+        os.path.abspath(__file__)))), "packages")
+    if os.path.isdir(source):
+        return source
+    return os.path.join(sys.prefix, "share", "orchestra", "packages")
+
+
+BUNDLED_PACKAGES = _bundled_packages_dir()
 
 #: the file catkin drops at the top of every devel and install space
 CATKIN_MARKER = ".catkin"

@@ -193,6 +193,20 @@ def output_mode(node: Node, options: RunOptions) -> OutputMode:
     return OutputMode.LOG
 
 
+def path_with_interpreter(path: str, executable: str) -> str:
+    """PATH with the directory of orchestra's own interpreter first, unless already on it.
+
+    Python nodes start with ``#!/usr/bin/env python3``; when orchestra runs from a virtualenv
+    that was not activated, that would find a Python without orchestra (and the node runtime)
+    installed. roslaunch has no such problem because ROS is installed system-wide.
+    """
+    directory = os.path.dirname(os.path.abspath(executable))
+    entries = [entry for entry in path.split(os.pathsep) if entry]
+    if directory in entries:
+        return path
+    return os.pathsep.join([directory, *entries])
+
+
 def build_specs(nodes: list[Node], executables: Mapping[str, str], master_uri: str,
                 run_dir: str, options: RunOptions,
                 environ: Mapping[str, str] | None = None) -> list[ProcessSpec]:
@@ -201,6 +215,7 @@ def build_specs(nodes: list[Node], executables: Mapping[str, str], master_uri: s
     # nodes write to pipes, not a TTY: without this, Python nodes block-buffer their output
     # and the console shows it late (roslaunch leaves screen nodes on the TTY instead)
     base.setdefault("PYTHONUNBUFFERED", "1")
+    base["PATH"] = path_with_interpreter(base.get("PATH", ""), sys.executable)
     specs = []
     for counter, node in enumerate(nodes, start=1):
         exe = executables[node.full_name]
