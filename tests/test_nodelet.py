@@ -242,3 +242,38 @@ def test_slow_local_subscriber_does_not_block_publisher_and_drops_oldest():
     while got[-1:] != [9] and time.monotonic() < deadline:
         time.sleep(0.01)
     assert got[-1] == 9 and len(got) <= 3
+
+
+# ---- bonds: a loader that died does not leave its nodelet behind ----------------------------
+def test_request_from_a_new_loader_replaces_the_old_nodelet(workspace, tmp_path):
+    make_plugin_package(workspace, "my_pkg", f"bond_{tmp_path.name}", GOOD)
+    manager = Manager()
+    old = manager.load("/thing", "my_pkg/Thing", {}, [], bond="http://h:1/")
+    new = manager.load("/thing", "my_pkg/Thing", {}, [], bond="http://h:2/")
+    assert old.stopped is True and new is not old
+    assert manager.list() == ["/thing"]
+    with pytest.raises(LoadError, match="already loaded"):   # same loader asking twice
+        manager.load("/thing", "my_pkg/Thing", {}, [], bond="http://h:2/")
+
+
+def test_unload_orphans_unloads_only_nodelets_whose_loader_is_dead(workspace, tmp_path):
+    make_plugin_package(workspace, "my_pkg", f"orph_{tmp_path.name}", GOOD)
+    manager = Manager()
+    manager.load("/alive", "my_pkg/Thing", {}, [], bond="http://h:1/")
+    manager.load("/dead", "my_pkg/Thing", {}, [], bond="http://h:2/")
+    manager.load("/unbonded", "my_pkg/Thing", {}, [])
+    assert manager.unload_orphans(lambda uri: uri.endswith(":1/")) == ["/dead"]
+    assert manager.list() == ["/alive", "/unbonded"]
+
+
+def test_uri_alive_tells_a_listening_port_from_a_closed_one():
+    import socket
+    from nodelet.manager import uri_alive
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen()
+    port = server.getsockname()[1]
+    assert uri_alive(f"http://127.0.0.1:{port}/")
+    server.close()
+    assert not uri_alive(f"http://127.0.0.1:{port}/")
+    assert uri_alive("not a uri")   # unknown: never unload on a guess

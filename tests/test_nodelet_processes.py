@@ -104,3 +104,17 @@ def test_usage_error_exits_2(spawn):
     proc = spawn("load", "only_a_type")
     assert proc.wait(timeout=15) == 2
     assert "usage: nodelet" in proc.stdout.read()
+
+
+def test_killed_loader_is_unloaded_and_a_respawned_one_loads_again(master, spawn):
+    manager = spawn("manager", "__name:=mgr")
+    args = ("load", "yocs_cmd_vel_mux/CmdVelMuxNodelet", "mgr", "__name:=mux",
+            f"_yaml_cfg_file:={MUX_YAML}")
+    loader = spawn(*args)
+    assert wait_until(lambda: publishers(master, "/mux/active") == ["/mgr"])
+    loader.kill()                       # no chance to unload: the manager must notice
+    loader.wait()
+    assert wait_until(lambda: publishers(master, "/mux/active") == [], timeout=10)
+    respawned = spawn(*args)
+    assert wait_until(lambda: publishers(master, "/mux/active") == ["/mgr"])
+    assert respawned.poll() is None and manager.poll() is None

@@ -22,6 +22,7 @@ USAGE = """usage: nodelet manager
 
 LOAD_WAIT_WARN = 10.0   # seconds between "still waiting for the manager" warnings
 WATCH_PERIOD = 1.0      # how often a loader checks that its manager is still there
+BOND_CHECK_PERIOD = 1.0  # how often a manager checks that its nodelets' loaders still run
 
 
 def _srv(name: str):
@@ -31,7 +32,7 @@ def _srv(name: str):
 
 def run_manager() -> int:
     from orchestra import node
-    from nodelet.manager import LoadError, Manager
+    from nodelet.manager import LoadError, Manager, uri_alive
 
     node.init_node("manager")
     manager = Manager()
@@ -41,7 +42,7 @@ def run_manager() -> int:
     def on_load(req):
         remaps = dict(zip(req.remap_source_args, req.remap_target_args))
         try:
-            manager.load(req.name, req.type, remaps, list(req.my_argv))
+            manager.load(req.name, req.type, remaps, list(req.my_argv), req.bond_id)
         except LoadError as exc:
             node.logerr("failed to load nodelet '%s' of type '%s': %s", req.name, req.type, exc)
             return load_cls.Response(success=False)
@@ -61,7 +62,12 @@ def run_manager() -> int:
     node.Service("~unload_nodelet", unload_cls, on_unload)
     node.Service("~list", list_cls, on_list)
     node.on_shutdown(manager.unload_all)
-    node.spin()
+    while not node.is_shutdown():
+        try:
+            node.sleep(BOND_CHECK_PERIOD)
+        except node.ROSInterruptException:
+            break
+        manager.unload_orphans(uri_alive)
     return 0
 
 
@@ -104,7 +110,8 @@ def run_loader(type_name: str, manager_name: str, extra: list[str]) -> int:
     load = node.ServiceProxy(load_name, _srv("nodelet/NodeletLoad"))
     try:
         resp = load(name=name, type=type_name, remap_source_args=list(remaps),
-                    remap_target_args=list(remaps.values()), my_argv=extra, bond_id="")
+                    remap_target_args=list(remaps.values()), my_argv=extra,
+                    bond_id=node.get_node_uri())
     except node.ServiceException as exc:
         node.logerr("loading nodelet %s of type %s failed: %s", name, type_name, exc)
         node.signal_shutdown("load failed")

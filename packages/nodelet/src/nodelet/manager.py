@@ -7,7 +7,10 @@ services.
 from __future__ import annotations
 
 import logging
+import socket
 import threading
+from typing import Callable
+from urllib.parse import urlparse
 
 from nodelet import names
 from nodelet.base import Nodelet
@@ -23,6 +26,21 @@ def is_user_error(exc: BaseException) -> bool:
     return isinstance(exc, (OrchestraError, RuntimeError, ValueError, KeyError, OSError))
 
 
+def uri_alive(uri: str, timeout: float = 1.0) -> bool:
+    """Does something still listen at a node's XML-RPC URI? A killed loader's port closes at
+    once, so a refused connection is a reliable death notice (no bond messages needed)."""
+    parsed = urlparse(uri)
+    if not parsed.hostname or not parsed.port:
+        return True  # nothing we can check: assume alive rather than unload wrongly
+    try:
+        with socket.create_connection((parsed.hostname, parsed.port), timeout=timeout):
+            return True
+    except ConnectionRefusedError:
+        return False
+    except OSError:
+        return True  # timeouts and routing trouble are not proof of death
+
+
 class LoadError(Exception):
     """Why a load request was refused; the manager stays up, the loader reports it."""
 
@@ -30,12 +48,25 @@ class LoadError(Exception):
 class Manager:
     def __init__(self) -> None:
         self._nodelets: dict[str, Nodelet] = {}
+        self._bonds: dict[str, str] = {}
         self._lock = threading.Lock()
 
     def load(self, name: str, type_name: str, remaps: dict[str, str],
-             my_argv: list[str]) -> Nodelet:
-        """Instantiate ``type_name`` as ``name`` and run its ``on_init``; raise LoadError."""
+             my_argv: list[str], bond: str = "") -> Nodelet:
+        """Instantiate ``type_name`` as ``name`` and run its ``on_init``; raise LoadError.
+
+        ``bond`` identifies the loader (its node URI). A request for a loaded name from a
+        DIFFERENT loader replaces the old nodelet: one node per name is the graph's rule (the
+        master shuts the older node of a name down), so the old loader is gone, typically
+        killed and respawned, and its nodelet must not block the new one.
+        """
         name = names.canonicalize(name)
+        with self._lock:
+            stale = (name in self._nodelets and self._nodelets[name] is not None and bond
+                     and self._bonds.get(name) not in ("", bond))
+        if stale:
+            log.warning("nodelet %s is requested by a new loader: replacing the old one", name)
+            self.unload(name)
         with self._lock:
             if name in self._nodelets:
                 raise LoadError(f"a nodelet named '{name}' is already loaded")
@@ -61,6 +92,7 @@ class Manager:
             raise
         with self._lock:
             self._nodelets[name] = instance
+            self._bonds[name] = bond
         log.info("loaded nodelet %s (%s)", name, type_name)
         return instance
 
@@ -68,6 +100,7 @@ class Manager:
         name = names.canonicalize(name)
         with self._lock:
             instance = self._nodelets.pop(name, None)
+            self._bonds.pop(name, None)
         if instance is None:
             return False
         instance.shutdown()
@@ -77,6 +110,19 @@ class Manager:
     def list(self) -> list[str]:
         with self._lock:
             return sorted(n for n, inst in self._nodelets.items() if inst is not None)
+
+    def bonds(self) -> dict[str, str]:
+        """Loaded nodelet name -> its loader's bond (URI), for the liveness watchdog."""
+        with self._lock:
+            return {n: b for n, b in self._bonds.items() if b}
+
+    def unload_orphans(self, alive: Callable[[str], bool]) -> list[str]:
+        """Unload every nodelet whose loader is no longer ``alive`` (ROS's broken bond)."""
+        gone = [name for name, bond in self.bonds().items() if not alive(bond)]
+        for name in gone:
+            log.warning("the loader of nodelet %s is gone: unloading it", name)
+            self.unload(name)
+        return gone
 
     def unload_all(self) -> None:
         for name in self.list():
