@@ -300,6 +300,16 @@ def test_cli_exit_status_and_line_format(ws):
     assert run_cli(bad, "nope:=1", env=env).returncode == 0
 
 
+def test_cli_json_output_lists_problems_with_positions(ws):
+    path = write(ws / "launch", "a.launch", '<launch>\n  <nod/>\n</launch>\n')
+    proc = run_cli(path, "--json", env=dict(os.environ))
+    assert proc.returncode == 1
+    document = json.loads(proc.stdout)
+    assert document["problems"] == [{
+        "file": path, "line": 2, "column": 3, "severity": "error", "code": "unknown-tag",
+        "message": "unknown tag <nod> (did you mean 'node'?) (roslaunch ignores it)"}]
+
+
 def test_cli_missing_file_is_reported_not_a_traceback(tmp_path):
     proc = run_cli(str(tmp_path / "none.launch"))
     assert proc.returncode == 1

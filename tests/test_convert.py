@@ -53,6 +53,9 @@ def test_xml_to_yaml_to_xml_round_trip_keeps_every_entity(launch_file):
     xml_text = convert.to_xml(from_yaml)
     back = xml_frontend.parse_string(xml_text, launch_file)
     assert shape(back) == shape(original)
+    # and the output is stable: converting the converted file again changes nothing
+    assert convert.to_yaml(from_yaml) == yaml_text
+    assert convert.to_xml(back) == xml_text
 
 
 def test_converted_yaml_keeps_line_numbers_meaningful():

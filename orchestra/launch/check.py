@@ -114,6 +114,11 @@ class Problem:
     def __str__(self) -> str:
         return f"{self.location}: {self.severity}: {self.message} [{self.code}]"
 
+    def to_json(self) -> dict[str, Any]:
+        return {"file": self.location.file, "line": self.location.line,
+                "column": self.location.column, "severity": self.severity,
+                "code": self.code, "message": self.message}
+
 
 @dataclass
 class Report:

@@ -64,8 +64,10 @@ def _expand(paths: list[str]) -> list[str]:
 @click.command()
 @click.argument("words", nargs=-1, required=True, metavar="FILE|DIR... [name:=value ...]")
 @click.option("--strict", is_flag=True, help="Warnings fail the check too.")
+@click.option("--json", "as_json", is_flag=True,
+              help="Print the problems as one JSON document (for editors and CI).")
 @click.pass_context
-def check(ctx: click.Context, words: tuple[str, ...], strict: bool) -> None:
+def check(ctx: click.Context, words: tuple[str, ...], strict: bool, as_json: bool) -> None:
     """Report every problem in launch files (and what they include), starting nothing.
 
     A DIR stands for every launch file under it. Args apply to every file checked.
@@ -84,8 +86,14 @@ def check(ctx: click.Context, words: tuple[str, ...], strict: bool) -> None:
         report = check_tree(_expand(paths), args)
     else:
         report = check_files(paths, args)
-    for problem in report.sorted():
-        click.echo(str(problem))
+    if as_json:
+        import json
+
+        click.echo(json.dumps({"files": report.files,
+                               "problems": [p.to_json() for p in report.sorted()]}, indent=1))
+    else:
+        for problem in report.sorted():
+            click.echo(str(problem))
     errors, warnings = len(report.errors), len(report.warnings)
     summary = (f"{len(report.files)} file(s) checked: {errors} error(s), "
                f"{warnings} warning(s)")
