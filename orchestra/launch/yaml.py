@@ -148,8 +148,10 @@ def _refuse_foreign_tags(root: Node, filename: str) -> None:
             continue
         seen.add(id(node))
         if node.tag not in _CORE_TAGS:
-            raise LaunchYamlError(f"YAML tag '{node.tag}' is not allowed in a launch file "
-                                  "(only plain scalars, mappings and lists)",
+            shown = node.tag.replace(_CORE_TAG_PREFIX, "!!", 1)
+            raise LaunchYamlError(f"YAML tag '{shown}' is not allowed in a launch file "
+                                  "(only plain scalars, mappings and lists; rosparam YAML "
+                                  "with its own tags goes in a 'text: |' block)",
                                   _location(filename, node))
         if isinstance(node, SequenceNode):
             stack.extend(node.value)
