@@ -137,6 +137,11 @@ class Publication:
 
     def publish(self, msg: Message) -> None:
         if self.closed:
+            if self.runtime.is_shutdown():
+                # the usual `while not is_shutdown(): publish()` race with a signal: the
+                # message has nowhere to go, and a traceback on Ctrl-C helps nobody
+                log.debug("dropped a message on %s: node is shutting down", self.topic)
+                return
             raise ROSException(f"publish() to {self.topic} after unregister()")
         if msg._type != self.msg_class._type and self.msg_class is not AnyMsg:
             raise ROSException(f"expected a {self.msg_class._type} message on {self.topic}, "
