@@ -530,6 +530,13 @@ class _ConsoleHandler(logging.Handler):
 def _setup_logging(level: int | None) -> None:
     if not any(isinstance(h, _ConsoleHandler) for h in _user_log.handlers):
         _user_log.addHandler(_ConsoleHandler())
+    library = logging.getLogger("orchestra.node")
+    if not logging.getLogger().handlers and not library.handlers:
+        # a node script that configured no logging still shows our warnings (refused
+        # connections, handler errors) in the same console format as its own log lines
+        handler = _ConsoleHandler()
+        handler.setLevel(logging.WARNING)
+        library.addHandler(handler)
     _user_log.propagate = False
     _user_log.setLevel(level if level is not None and level >= 10 else logging.INFO)
 
