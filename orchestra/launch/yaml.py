@@ -171,7 +171,7 @@ class _Guard:
     """Stops YAML aliases from expanding forever (``&a [*a]``) or exponentially (a few
     nested aliases repeated: the "billion laughs"): Entities are a tree, aliases are copied."""
 
-    MAX_ELEMENTS = 100_000
+    MAX_ELEMENTS = 20_000  # real launch trees hold hundreds
 
     def __init__(self) -> None:
         self.active: set[int] = set()
