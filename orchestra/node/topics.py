@@ -419,13 +419,17 @@ class Subscription:
                 except Exception:  # a user callback must not kill the connection
                     log.exception("error in callback for %s", self.topic)
 
-    def update_publishers(self, uris: list[str]) -> None:
-        """Connect to listed publishers we lack, drop those no longer listed (idempotent)."""
+    def update_publishers(self, uris: list[str], additive: bool = False) -> None:
+        """Connect to listed publishers we lack, drop those no longer listed (idempotent).
+
+        ``additive`` (the registerSubscriber answer) only adds: a publisherUpdate sent
+        after the master answered may overtake that answer, and must not be undone by it.
+        """
         with self.lock:
             if self.closed:
                 return
             wanted = [u for u in dict.fromkeys(uris) if u != self.runtime.uri]
-            gone = [u for u in self.connections if u not in wanted]
+            gone = [] if additive else [u for u in self.connections if u not in wanted]
             for uri in gone:
                 self.connections.pop(uri).close()
             new = []
@@ -534,7 +538,7 @@ class TopicManager:
             sub = Subscription(self.rt, topic, msg_class, queue_size)
             self.subscriptions[topic] = sub
         publishers = self.rt.master_register("registerSubscriber", topic, msg_class._type)
-        sub.update_publishers(list(publishers or []))
+        sub.update_publishers(list(publishers or []), additive=True)
         return sub
 
     def release_subscription(self, sub: Subscription, cb: Callable | None, args: Any) -> None:
