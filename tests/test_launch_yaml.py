@@ -228,3 +228,22 @@ def test_example_yaml_launch_file_resolves_like_its_xml_original(compat_dir):
 
     assert plan_of(REPO / "launch" / "turtle_tf_demo.launch.yaml") == \
         plan_of(compat_dir / "ws" / "turtle_tf" / "launch" / "turtle_tf_demo.launch")
+
+
+@pytest.mark.parametrize("loader", ["SafeLoader", "CSafeLoader"])
+def test_pure_and_libyaml_composers_read_the_same_entities(loader, monkeypatch):
+    import yaml as pyyaml
+
+    from orchestra.launch import yaml as front
+
+    if not hasattr(pyyaml, loader):
+        pytest.skip(f"PyYAML built without {loader}")
+    monkeypatch.setattr(front, "_LOADER", getattr(pyyaml, loader))
+    root = parse("launch:\n  - param: {name: p, value: 1.10}\n  - rosparam:\n"
+                 "      text: |\n        a: !degrees 90\n")
+    assert root.children[0].location == Location("t.launch.yaml", 2, 5)
+    assert root.children[0].get("value") == "1.10"
+    assert root.children[1].text == "a: !degrees 90\n"
+    err = error_of("launch:\n  - node: {pkg: p\n")
+    assert err.message.startswith("invalid YAML") and err.location.line is not None
+    assert "not allowed" in error_of("launch: [{param: !!python/name:os.system x}]\n").message
