@@ -67,7 +67,7 @@ _CORE_TAGS = frozenset(_CORE_TAG_PREFIX + name for name in (
     "str", "int", "float", "bool", "null", "map", "seq", "merge", "timestamp", "value",
 ))
 
-# libyaml's composer when PyYAML was built with it (about 25x faster on launch files, and
+# libyaml's composer when PyYAML was built with it (much faster than the pure-Python one, and
 # ``orchestra launch`` start-up time matters); same nodes, tags and marks as the pure one.
 _LOADER = getattr(pyyaml, "CSafeLoader", pyyaml.SafeLoader)
 
