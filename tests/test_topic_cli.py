@@ -201,3 +201,28 @@ def test_commands_fail_cleanly_without_a_master(nodes):
     listing = subprocess.run([sys.executable, "-m", "orchestra", "node", "list"], env=env,
                              capture_output=True, text=True, timeout=30)
     assert listing.returncode == 1 and "cannot contact the master" in listing.stderr
+
+
+def test_node_ping_and_cleanup_of_a_node_that_died_without_unregistering(nodes):
+    alive = nodes.start("sub.py", "chatter", "std_msgs/String", "--name", "alive")
+    alive.ready()
+    ghost = nodes.start("pub.py", "chatter", "std_msgs/String", "data: x", "--name", "ghost")
+    ghost.ready()
+    ping = orchestra(nodes, "node", "ping", "/ghost")
+    assert ping.returncode == 0 and ping.stdout.startswith("xmlrpc reply from http://")
+    ghost.signal(9)
+    ghost.wait()
+    dead = orchestra(nodes, "node", "ping", "/ghost")
+    assert dead.returncode == 1 and "does not answer" in dead.stderr
+    cleanup = orchestra(nodes, "node", "cleanup", "--yes")
+    assert cleanup.returncode == 0, cleanup.stderr
+    assert " * /ghost" in cleanup.stdout and "/alive" not in cleanup.stdout
+    assert orchestra(nodes, "node", "list").stdout.split() == ["/alive"]
+    assert orchestra(nodes, "topic", "find", "std_msgs/String").stdout == "/chatter\n"
+    assert orchestra(nodes, "topic", "find", "std_msgs/Int8").stdout == ""
+
+
+def test_service_uri_and_args(nodes):
+    nodes.start("adder.py", "add").ready()
+    assert orchestra(nodes, "service", "uri", "/add").stdout.startswith("rosrpc://127.0.0.1:")
+    assert orchestra(nodes, "service", "args", "/add").stdout == "a b\n"

@@ -169,6 +169,43 @@ def node_kill(names: tuple[str, ...], kill_all: bool) -> None:
     click.echo("killed")
 
 
+@node.command("ping")
+@click.argument("name")
+@click.option("-c", "count", type=click.IntRange(min=1), default=1, show_default=True,
+              help="Number of pings.")
+def node_ping(name: str, count: int) -> None:
+    """Check that NAME answers on its XML-RPC API, and how fast."""
+    uri_master = _master_uri()
+    name = _global(name)
+    for i in range(count):
+        uri, rtt = introspect.ping_node(uri_master, name)
+        if rtt is None:
+            raise CommandFailed(f"node [{name}] at {uri} does not answer")
+        click.echo(f"xmlrpc reply from {uri}\ttime={rtt * 1000:.6f}ms")
+        if i + 1 < count:
+            time.sleep(1.0)
+
+
+@node.command("cleanup")
+@click.option("-y", "--yes", is_flag=True, help="Purge without asking.")
+def node_cleanup(yes: bool) -> None:
+    """Unregister nodes that died without unregistering (their API no longer answers)."""
+    uri = _master_uri()
+    state = introspect.system_state(uri)
+    dead = introspect.unreachable_nodes(uri, state)
+    if not dead:
+        click.echo("no unreachable nodes")
+        return
+    click.echo("Unable to contact the following nodes:")
+    for name in dead:
+        click.echo(f" * {name}")
+    if not yes and not click.confirm("Purge them from the master?", default=False):
+        return
+    for name in dead:
+        introspect.purge_node(uri, state, name)
+        click.echo(f"unregistered {name}")
+
+
 # --- topic --------------------------------------------------------------------------------------
 
 @click.group()
@@ -205,6 +242,17 @@ def topic_type(name: str) -> None:
     if name not in state.types:
         raise OrchestraError(f"unknown topic {name} (nobody publishes it)")
     click.echo(state.types[name])
+
+
+@topic.command("find")
+@click.argument("type_name", metavar="TYPE")
+def topic_find(type_name: str) -> None:
+    """Print the published topics of message type TYPE."""
+    from orchestra.node.msg import normalise_type
+    wanted = normalise_type(type_name)
+    for name, type_ in sorted(introspect.system_state(_master_uri()).types.items()):
+        if type_ == wanted:
+            click.echo(name)
 
 
 @topic.command("info")
@@ -457,6 +505,25 @@ def service_list() -> None:
 def service_type(name: str) -> None:
     """Print the service type of NAME (asked from the service itself)."""
     click.echo(introspect.service_header(_master_uri(), _global(name)).get("type", ""))
+
+
+@service.command("uri")
+@click.argument("name")
+def service_uri(name: str) -> None:
+    """Print the rosrpc:// URI of NAME."""
+    click.echo(introspect.service_uri(_master_uri(), _global(name)))
+
+
+@service.command("args")
+@click.argument("name")
+def service_args(name: str) -> None:
+    """Print the request field names of NAME."""
+    from orchestra.node.msg import MessageNotFound, get_service_class
+    srv_type = introspect.service_header(_master_uri(), _global(name)).get("type", "")
+    try:
+        click.echo(" ".join(get_service_class(srv_type)._request_class._fields))
+    except (MessageNotFound, ROSException) as exc:
+        raise OrchestraError(f"cannot tell the arguments of {name}: {exc}") from None
 
 
 @service.command("info")

@@ -114,3 +114,44 @@ def service_header(master_uri: str, service: str) -> dict[str, str]:
     if "error" in header:
         raise GraphError(f"service [{service}]: {header['error']}")
     return header
+
+
+def ping_node(master_uri: str, node: str) -> tuple[str, float | None]:
+    """(slave URI, round-trip seconds of ``getPid``), None when the node does not answer."""
+    import time
+
+    uri = lookup_node(master_uri, node)
+    start = time.monotonic()
+    try:
+        call(uri, "getPid", CALLER, timeout=2.0)
+    except MasterError:
+        return uri, None
+    return uri, time.monotonic() - start
+
+
+def unreachable_nodes(master_uri: str, state: SystemState) -> list[str]:
+    """Nodes the master lists whose slave API does not answer (died without unregistering)."""
+    dead = []
+    for node in state.nodes:
+        try:
+            _, rtt = ping_node(master_uri, node)
+        except GraphError:
+            continue
+        if rtt is None:
+            dead.append(node)
+    return dead
+
+
+def purge_node(master_uri: str, state: SystemState, node: str) -> None:
+    """Unregister everything ``node`` registered, on its behalf (rosnode cleanup)."""
+    api = lookup_node(master_uri, node)
+    for topic in state.node_publications(node):
+        raw_call(master_uri, "unregisterPublisher", node, topic, api, timeout=5.0)
+    for topic in state.node_subscriptions(node):
+        raw_call(master_uri, "unregisterSubscriber", node, topic, api, timeout=5.0)
+    for service in state.node_services(node):
+        try:
+            uri = master_call(master_uri, "lookupService", service)
+        except GraphError:
+            continue
+        raw_call(master_uri, "unregisterService", node, service, uri, timeout=5.0)
