@@ -99,7 +99,7 @@ def _stop_cli_node(reason: str) -> None:
 
 @click.group()
 def node() -> None:
-    """Running nodes: list, info, kill (like rosnode)."""
+    """Running nodes: list, info, kill, ping, cleanup (like rosnode)."""
 
 
 @node.command("list")
@@ -210,7 +210,7 @@ def node_cleanup(yes: bool) -> None:
 
 @click.group()
 def topic() -> None:
-    """Topics: list, info, type, echo, pub, hz (like rostopic)."""
+    """Topics: list, find, info, type, echo, pub, hz (like rostopic)."""
 
 
 @topic.command("list")
@@ -490,7 +490,7 @@ def hz_report(stamps: list[float]) -> str:
 
 @click.group()
 def service() -> None:
-    """Services: list, info, type, call (like rosservice)."""
+    """Services: list, info, type, uri, args, call (like rosservice)."""
 
 
 @service.command("list")
