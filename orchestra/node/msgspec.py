@@ -9,6 +9,7 @@ connection headers is the definition followed by each dependency's definition.
 from __future__ import annotations
 
 import hashlib
+import keyword
 import re
 from dataclasses import dataclass
 from typing import Callable
@@ -142,6 +143,9 @@ def parse_msg(text: str, msg_type: str, source: str | None = None) -> MsgSpec:
             raise MsgSpecError(f"{where}: bad field name {name!r}")
         if name in names:
             raise MsgSpecError(f"{where}: duplicate field {name!r}")
+        if keyword.iskeyword(name):
+            raise MsgSpecError(f"{where}: field name {name!r} is a Python keyword "
+                               "(not supported by orchestra's message classes)")
         names.add(name)
         array: int | None = None
         base = type_text

@@ -52,11 +52,12 @@ def _advertise_host(special: dict[str, str], master_uri: str) -> str:
 class TcprosServer:
     """Accepts TCPROS connections and hands each to the topic or service it asks for."""
 
-    def __init__(self, runtime: "NodeRuntime", bind_host: str, advertise_host: str):
+    def __init__(self, runtime: "NodeRuntime", bind_host: str, advertise_host: str,
+                 port: int = 0):
         self.rt = runtime
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
         self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        self.sock.bind((bind_host, 0))
+        self.sock.bind((bind_host, port))
         self.sock.listen(128)
         self.port = self.sock.getsockname()[1]
         self.host = advertise_host
@@ -139,11 +140,17 @@ class NodeRuntime:
         self._hooks: list[Callable[..., Any]] = []
         self.params: dict[str, Any] = {}
 
-    def start(self) -> None:
+    def start(self, xmlrpc_port: int = 0, tcpros_port: int = 0) -> None:
+        """Open both servers (port 0 = any free port, the default) and start serving."""
         from orchestra.node.slave import SlaveServer
 
-        self._tcpros = TcprosServer(self, self._bind, self._host)
-        self._slave = SlaveServer(self, self._bind, self._host)
+        try:
+            self._tcpros = TcprosServer(self, self._bind, self._host, tcpros_port)
+            self._slave = SlaveServer(self, self._bind, self._host, xmlrpc_port)
+        except OSError as exc:
+            if self._tcpros is not None:
+                self._tcpros.stop()
+            raise ROSInitException(f"cannot open the node's ports on {self._bind}: {exc}") from exc
         self._tcpros.start()
         self._slave.start()
         rostime._set_shutdown_event(self._shutdown_requested)
@@ -306,7 +313,9 @@ def init_node(name: str, argv: list[str] | None = None, anonymous: bool = False,
               log_level: int | None = None, disable_rostime: bool = False,
               disable_rosout: bool = False, disable_signals: bool = False,
               xmlrpc_port: int = 0, tcpros_port: int = 0) -> None:
-    """Make this process the node ``name`` (see rospy.init_node; same argv conventions)."""
+    """Make this process the node ``name`` (see rospy.init_node; same argv conventions).
+
+    ``disable_rostime`` is accepted for rospy compatibility; time is always wall time."""
     global _runtime
     argv = list(sys.argv if argv is None else argv)
     parsed = names.parse_args(argv)
@@ -330,7 +339,7 @@ def init_node(name: str, argv: list[str] | None = None, anonymous: bool = False,
         remaps = names.resolve_remaps(parsed.remaps, namespace, full_name)
         host = _advertise_host(special, master_uri)
         runtime = NodeRuntime(full_name, namespace, master_uri, remaps, host, argv)
-        runtime.start()
+        runtime.start(xmlrpc_port, tcpros_port)
         _runtime = runtime
     _setup_logging(log_level)
     atexit.register(_at_exit)
