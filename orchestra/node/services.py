@@ -195,7 +195,7 @@ class ServiceProxy:
 
         self._rt = get_runtime()
         self.resolved_name = self.name = self._rt.resolve_name(name)
-        self.service_class = self.request_class = service_class
+        self.service_class = service_class
         self.request_class = service_class._request_class
         self.response_class = service_class._response_class
         self.persistent = persistent
