@@ -71,3 +71,12 @@ def test_rosrpc_uri_parsing():
     assert tcpros.parse_rosrpc_uri("rosrpc://host.local:4567") == ("host.local", 4567)
     with pytest.raises(TransportException):
         tcpros.parse_rosrpc_uri("http://x:1/")
+
+
+def test_bus_counters_beyond_32_bits_still_fit_in_xmlrpc():
+    import xmlrpc.client
+
+    from orchestra.node.topics import xmlrpc_int
+    assert xmlrpc_int(5) == 5 and isinstance(xmlrpc_int(5), int)
+    big = xmlrpc_int(3 * 2**31)
+    assert xmlrpc.client.loads(xmlrpc.client.dumps(([big],)))[0][0] == [3 * 2**31]

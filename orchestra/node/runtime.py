@@ -228,8 +228,10 @@ class NodeRuntime:
         with self._services_lock:
             servers = list(self.services.values())
         # ROS: serviceStats = [numRequests, bytesReceived, bytesSent]
-        return [pubs, subs, [sum(s.calls for s in servers), sum(s.bytes_in for s in servers),
-                             sum(s.bytes_out for s in servers)]]
+        from orchestra.node.topics import xmlrpc_int
+        return [pubs, subs, [xmlrpc_int(sum(s.calls for s in servers)),
+                             xmlrpc_int(sum(s.bytes_in for s in servers)),
+                             xmlrpc_int(sum(s.bytes_out for s in servers))]]
 
     def bus_info(self) -> list:
         return self.topics.bus_info()

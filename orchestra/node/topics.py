@@ -611,11 +611,12 @@ class TopicManager:
             pub.prune()
         with self.lock:
             for topic, pub in self.publications.items():
-                conns = [[c.id, c.bytes_sent, c.messages_sent, not c.closed]
-                         for c in list(pub.connections)]
-                pubs.append([topic, sum(c[1] for c in conns), conns])
+                conns = [[c.id, xmlrpc_int(c.bytes_sent), xmlrpc_int(c.messages_sent),
+                          not c.closed] for c in list(pub.connections)]
+                pubs.append([topic, xmlrpc_int(sum(c.bytes_sent for c in pub.connections)),
+                             conns])
             for topic, sub in self.subscriptions.items():
-                conns = [[c.id, c.bytes_received, c.drops, c.connected]
+                conns = [[c.id, xmlrpc_int(c.bytes_received), xmlrpc_int(c.drops), c.connected]
                          for c in list(sub.connections.values())]
                 subs.append([topic, conns])
         return pubs, subs
@@ -632,6 +633,12 @@ class TopicManager:
                 for c in list(sub.connections.values()):
                     info.append([c.id, c.uri, "i", "TCPROS", topic, c.connected, ""])
         return info
+
+
+def xmlrpc_int(n: int) -> int | float:
+    """XML-RPC integers are 32-bit: byte counters of a camera stream pass 2**31 within
+    seconds, so larger counts travel as doubles instead of failing the whole call."""
+    return n if -2**31 <= n < 2**31 else float(n)
 
 
 def _refuse(sock: socket.socket, error: str, reason: str) -> None:
