@@ -149,7 +149,7 @@ class Publication:
         with self.lock:
             self.seq += 1
             if msg._has_header:
-                msg.header.seq = self.seq
+                msg.header.seq = self.seq & 0xFFFFFFFF  # uint32 on the wire
             data = msg.serialize_bytes()
             if self.latch:
                 self.latched = data
