@@ -37,7 +37,7 @@ def run_cli(*args, env=None, cwd=None):
 # ------------------------------------------------------------------ the whole smoke corpus
 
 @pytest.mark.parametrize("launch_file", [item["launch_file"] for item in SMOKE])
-def test_xml_to_yaml_to_xml_round_trip_keeps_every_entity(launch_file):
+def test_xml_to_yaml_to_xml_round_trip_keeps_every_entity(launch_file, tmp_path):
     path = str(WS / launch_file)
     try:
         original = xml_frontend.parse_file(path)
@@ -56,6 +56,12 @@ def test_xml_to_yaml_to_xml_round_trip_keeps_every_entity(launch_file):
     # and the output is stable: converting the converted file again changes nothing
     assert convert.to_yaml(from_yaml) == yaml_text
     assert convert.to_xml(back) == xml_text
+    # the files, with their comments carried over, still read as the same Entities
+    commented = tmp_path / "c.launch.yaml"
+    commented.write_text(convert.convert_file(path, "yaml"))
+    assert shape(yaml_frontend.parse_file(str(commented))) == shape(original)
+    xml_again = convert.convert_file(str(commented), "xml")
+    assert shape(xml_frontend.parse_string(xml_again, "x")) == shape(original)
 
 
 def test_converted_yaml_keeps_line_numbers_meaningful():
@@ -179,6 +185,48 @@ def test_rosparam_text_survives_both_directions_exactly(text):
     yaml_text = convert.to_yaml(entity)
     assert yaml_frontend.parse_string(yaml_text, "x.yaml").children[0].text == text
     assert xml_frontend.parse_string(convert.to_xml(entity), "x").children[0].text == text
+
+
+COMMENTED_XML = """<?xml version="1.0"?>
+<!-- Demo launch file.
+     Two lines of header. -->
+<launch>
+  <!-- the robot's name -->
+  <arg name="robot" default="r1"/>
+  <group ns="$(arg robot)">
+    <!-- first -->
+    <!-- second -->
+    <node pkg="p" type="t" name="n"/>
+  </group>
+  <param name="x" value="1"/>  <!-- trailing: not before an element of its own -->
+</launch>
+"""
+
+
+def test_comments_before_elements_travel_to_yaml_and_back(tmp_path):
+    src = tmp_path / "a.launch"
+    src.write_text(COMMENTED_XML)
+    yaml_text = convert.convert_file(str(src), "yaml")
+    assert yaml_text.splitlines()[:5] == [
+        "# Demo launch file.", "# Two lines of header.", "launch:",
+        "  # the robot's name", "  - arg: {name: robot, default: r1}"]
+    assert "        # first\n        # second\n        - node:" in yaml_text
+    converted = tmp_path / "a.launch.yaml"
+    converted.write_text(yaml_text)
+    xml_text = convert.convert_file(str(converted), "xml")
+    assert "<!-- the robot's name -->\n  <arg" in xml_text
+    # YAML has no boundary between comment lines: two comments come back as one
+    assert "<!--\n      first\n      second\n    -->\n    <node" in xml_text
+    assert xml_text.index("Two lines of header.") < xml_text.index("<launch>")
+    assert shape(xml_frontend.parse_string(xml_text, "b")) == \
+        shape(xml_frontend.parse_file(str(src)))
+
+
+def test_comment_that_xml_cannot_hold_is_made_valid():
+    entity = Entity("launch", children=[Entity("arg", {"name": "a"})])
+    xml_text = convert.to_xml(entity, {id(entity.children[0]): ["a -- b -"]})
+    assert "<!-- a - - b - -->" in xml_text
+    assert shape(xml_frontend.parse_string(xml_text, "x")) == shape(entity)
 
 
 def test_multiline_rosparam_text_is_written_as_a_literal_block():

@@ -17,6 +17,7 @@ import fnmatch
 import glob
 import os
 import re
+import textwrap
 from dataclasses import dataclass
 
 import yaml as pyyaml
@@ -54,12 +55,16 @@ def load_entity(path: str) -> Entity:
     return xml_frontend.parse_file(path)
 
 
-def to_text(entity: Entity, fmt: str) -> str:
+Comments = dict[int, list[str]]
+"""Comment lines written just before an element, keyed by ``id()`` of its Entity."""
+
+
+def to_text(entity: Entity, fmt: str, comments: Comments | None = None) -> str:
     """The launch file text of ``entity`` in format ``fmt`` ("yaml" or "xml")."""
     if fmt == "yaml":
-        return to_yaml(entity)
+        return to_yaml(entity, comments)
     if fmt == "xml":
-        return to_xml(entity)
+        return to_xml(entity, comments)
     raise ConvertError(f"unknown target format '{fmt}' (expected one of {', '.join(FORMATS)})")
 
 
@@ -136,18 +141,64 @@ def _children_node(children: list[Entity]) -> SequenceNode:
                         flow_style=False)
 
 
-def to_yaml(entity: Entity) -> str:
-    """YAML launch text that the YAML front end reads back into an Entity equal to ``entity``."""
+def to_yaml(entity: Entity, comments: Comments | None = None) -> str:
+    """YAML launch text that the YAML front end reads back into an Entity equal to ``entity``.
+
+    ``comments`` (from ``read_comments``) are written as ``#`` lines just above their element.
+    """
     document = MappingNode(_MAP_TAG, [(_scalar(entity.tag), _body_node(entity))],
                            flow_style=False)
-    return pyyaml.serialize(document, Dumper=_IndentedDumper, allow_unicode=True,
+    text = pyyaml.serialize(document, Dumper=_IndentedDumper, allow_unicode=True,
                             width=_FLOW_WIDTH)
+    if comments:
+        text = _yaml_with_comments(text, entity, comments)
+    return text
+
+
+def _yaml_with_comments(text: str, entity: Entity, comments: Comments) -> str:
+    """Insert comment lines above the lines the elements were written on.
+
+    The emitter knows nothing of comments, so the text is read back (the reader gives each
+    element's line and column, and reads the elements in the same order) and the comment
+    lines go in above, indented like the element's ``-``.
+    """
+    reread = yaml_frontend.parse_string(text, "<converted>")
+    lines = text.split("\n")
+    inserts: list[tuple[int, list[str]]] = []
+    for original, written in zip(_preorder(entity), _preorder(reread)):
+        block = comments.get(id(original))
+        if not block or written.location.line is None:
+            continue
+        column = written.location.column or 1
+        indent = " " * (column - 3) if column >= 3 else ""
+        inserts.append((written.location.line - 1,
+                        [indent + ("# " + line if line else "#") for line in block]))
+    for index, block in sorted(inserts, key=lambda item: item[0], reverse=True):
+        lines[index:index] = block
+    return "\n".join(lines)
+
+
+def _preorder(entity: Entity):
+    yield entity
+    for child in entity.children:
+        yield from _preorder(child)
 
 
 # ---------------------------------------------------------------------------- Entity -> XML
 
 
-def _xml_element(entity: Entity, depth: int) -> etree._Element:
+def _xml_comment(lines: list[str], depth: int) -> etree._Comment:
+    """An XML comment holding ``lines`` ("--" cannot appear in one, so it is spaced out)."""
+    cleaned = [line.replace("--", "- -").replace("--", "- -") for line in lines]
+    if len(cleaned) == 1:
+        body = f" {cleaned[0]} "
+    else:
+        pad = "\n" + "  " * depth
+        body = "".join(pad + "  " + line for line in cleaned) + pad
+    return etree.Comment(body)
+
+
+def _xml_element(entity: Entity, depth: int, comments: Comments) -> etree._Element:
     try:
         element = etree.Element(entity.tag)
     except ValueError:
@@ -170,7 +221,16 @@ def _xml_element(entity: Entity, depth: int) -> etree._Element:
         raise ConvertError(f"the text of <{entity.tag}> cannot be written as XML (control "
                            "characters)", entity.location) from None
     for index, child in enumerate(entity.children):
-        sub = _xml_element(child, depth + 1)
+        block = comments.get(id(child))
+        if block:
+            try:
+                comment = _xml_comment(block, depth + 1)
+            except ValueError:
+                comment = None  # a comment XML cannot hold: dropped, it is only a comment
+            if comment is not None:
+                comment.tail = indent
+                element.append(comment)
+        sub = _xml_element(child, depth + 1, comments)
         if indent is not None:
             last = index == len(entity.children) - 1
             sub.tail = "\n" + "  " * depth if last else indent
@@ -178,11 +238,112 @@ def _xml_element(entity: Entity, depth: int) -> etree._Element:
     return element
 
 
-def to_xml(entity: Entity) -> str:
-    """XML launch text that the XML front end reads back into an Entity equal to ``entity``."""
-    root = _xml_element(entity, 0)
+def to_xml(entity: Entity, comments: Comments | None = None) -> str:
+    """XML launch text that the XML front end reads back into an Entity equal to ``entity``.
+
+    ``comments`` (from ``read_comments``) are written as ``<!-- -->`` just before their
+    element.
+    """
+    comments = comments or {}
+    root = _xml_element(entity, 0, comments)
+    header = ""
+    if comments.get(id(entity)):
+        try:
+            header = etree.tostring(_xml_comment(comments[id(entity)], 0),
+                                    encoding="unicode") + "\n"
+        except ValueError:
+            header = ""
     body = etree.tostring(root, encoding="unicode")
-    return '<?xml version="1.0"?>\n' + body + "\n"
+    return '<?xml version="1.0"?>\n' + header + body + "\n"
+
+
+# -------------------------------------------------------------------------------- comments
+
+
+def read_comments(path: str, root: Entity) -> Comments:
+    """The comments written just before each element of the launch file ``path`` (whose
+    Entity tree is ``root``), so that a conversion can carry them over.
+
+    Only comments that directly precede an element are kept (with nothing but other comments
+    and whitespace between): those are the ones that describe it. Others (after the last
+    child of an element, inside rosparam text) have no element to travel with.
+    """
+    try:
+        if format_of(path) == "yaml":
+            return _yaml_comments(path, root)
+        return _xml_comments(path, root)
+    except (OSError, UnicodeDecodeError, etree.XMLSyntaxError, OrchestraError):
+        return {}
+
+
+def _comment_lines(text: str) -> list[str]:
+    """A comment's lines without the indentation of the file it came from. A first line
+    written on the opening ``<!--`` line is dedented on its own (its indentation is the
+    opener's, not the block's)."""
+    first, newline, rest = text.partition("\n")
+    if first.strip() and newline:
+        lines = [first.strip()] + textwrap.dedent(rest).split("\n")
+    else:
+        lines = textwrap.dedent(text.strip("\n")).split("\n")
+    lines = [line.rstrip() for line in lines]
+    while lines and not lines[0].strip():
+        lines.pop(0)
+    while lines and not lines[-1].strip():
+        lines.pop()
+    if len(lines) == 1:
+        lines = [lines[0].strip()]
+    return lines
+
+
+def _xml_comments(path: str, root: Entity) -> Comments:
+    from orchestra.launch.files import read_bytes
+
+    parser = etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False,
+                             remove_pis=True, remove_comments=False)
+    tree = etree.fromstring(read_bytes(path), parser)
+    launch = next((el for el in tree.iter() if isinstance(el.tag, str)
+                   and el.tag == root.tag), None)
+    if launch is None:
+        return {}
+    elements = [launch] + [el for el in launch.iterdescendants() if isinstance(el.tag, str)]
+    entities = list(_preorder(root))
+    if len(elements) != len(entities):
+        return {}  # not the tree the front end read: carry nothing rather than misplace
+    comments: Comments = {}
+    for element, entity in zip(elements, entities):
+        block: list[str] = []
+        for sibling in element.itersiblings(preceding=True):
+            if isinstance(sibling.tag, str):
+                break
+            if sibling.tag is etree.Comment and sibling.text and sibling.text.strip():
+                block[0:0] = _comment_lines(sibling.text)
+        if block:
+            comments[id(entity)] = block
+    return comments
+
+
+def _yaml_comments(path: str, root: Entity) -> Comments:
+    from orchestra.launch.files import read_text
+
+    lines = read_text(path).split("\n")
+    comments: Comments = {}
+    used_lines: set[int] = set()
+    for entity in _preorder(root):
+        line = entity.location.line
+        if line is None or line in used_lines:
+            continue  # several elements on one line: the comment above is the first one's
+        used_lines.add(line)
+        block: list[str] = []
+        index = line - 2
+        while index >= 0 and lines[index].lstrip().startswith("#"):
+            text = lines[index].lstrip()[1:]
+            block.insert(0, text[1:] if text.startswith(" ") else text)
+            index -= 1
+        while block and not block[0].strip():
+            block.pop(0)
+        if block:
+            comments[id(entity)] = block
+    return comments
 
 
 # ------------------------------------------------------------------------------ whole files
@@ -206,8 +367,10 @@ def target_name(path: str, fmt: str) -> str:
 
 
 def convert_file(path: str, fmt: str) -> str:
-    """The text of launch file ``path`` converted to ``fmt`` (includes are left as written)."""
-    return to_text(load_entity(path), fmt)
+    """The text of launch file ``path`` converted to ``fmt``, comments carried over
+    (includes are left as written)."""
+    entity = load_entity(path)
+    return to_text(entity, fmt, read_comments(path, entity))
 
 
 @dataclass(frozen=True)
@@ -281,8 +444,9 @@ def convert_tree(directory: str, fmt: str) -> list[Converted]:
                                f"{target}", Location(src))
         taken[target] = src
         entity = load_entity(src)
+        comments = read_comments(src, entity)
         _rewrite_includes(entity, src, converted, fmt)
-        results.append((target, to_text(entity, fmt)))
+        results.append((target, to_text(entity, fmt, comments)))
     for target, text in results:
         with open(target, "w", encoding="utf-8") as fh:
             fh.write(text)
