@@ -458,8 +458,9 @@ def topic_hz(name: str, window: int | None, reports: int | None) -> None:
             try:
                 stamp, _ = inbox.get(timeout=timeout)
                 stamps.append(stamp)
-                if window is not None and len(stamps) > window + 1:
-                    del stamps[:-window - 1]
+                keep = window if window is not None else 50000  # rostopic's default cap
+                if len(stamps) > keep + 1:
+                    del stamps[:-keep - 1]
                 continue
             except queue.Empty:
                 pass
