@@ -87,7 +87,8 @@ PROBE = textwrap.dedent('''
 
     node.init_node("turtlebot_probe", anonymous=True)
     lock = threading.Lock()
-    seen = {"odom": [], "agg": None, "active": [], "ekf": None, "tf_static": [], "tf": []}
+    seen = {"odom": [], "agg": None, "active": [], "ekf": None, "tf_static": [], "tf": [],
+            "core": [], "imu": None}
 
     def keep(key, value, append=False):
         with lock:
@@ -104,7 +105,12 @@ PROBE = textwrap.dedent('''
                     lambda m: keep("active", m.data, True))
     node.Subscriber("/robot_pose_ekf/odom_combined",
                     M("geometry_msgs/PoseWithCovarianceStamped"),
-                    lambda m: keep("ekf", [m.pose.pose.position.x, m.header.frame_id]))
+                    lambda m: keep("ekf", [m.pose.pose.position.x, m.header.frame_id,
+                                           m.pose.covariance[0], m.pose.covariance[35]]))
+    node.Subscriber("/mobile_base/sensors/core", M("kobuki_msgs/SensorState"), lambda m: keep(
+        "core", [m.left_encoder, m.right_encoder, m.battery], True))
+    node.Subscriber("/mobile_base/sensors/imu_data", M("sensor_msgs/Imu"), lambda m: keep(
+        "imu", [m.header.frame_id, m.orientation.w]))
     node.Subscriber("/tf_static", M("tf2_msgs/TFMessage"), lambda m: keep(
         "tf_static", [t.child_frame_id for t in m.transforms]))
     def on_tf(m):
@@ -122,9 +128,10 @@ PROBE = textwrap.dedent('''
             time.sleep(0.05)
         return False
 
-    wait(lambda: seen["odom"])
+    wait(lambda: seen["odom"] and seen["core"])
     with lock:
         start = seen["odom"][-1] if seen["odom"] else None
+        core_start = seen["core"][-1] if seen["core"] else None
     twist = M("geometry_msgs/Twist")()
     twist.linear.x = 0.4
     stop = time.time() + 1.5
@@ -136,6 +143,7 @@ PROBE = textwrap.dedent('''
     wait(lambda: seen["active"][-1:] == ["idle"])
     with lock:
         seen["start"] = start
+        seen["core"] = [core_start, seen["core"][-1]] if seen["core"] else []
         sys.stdout.write(json.dumps(seen) + "\\n")
     node.signal_shutdown("probe done")
 ''')
@@ -188,9 +196,19 @@ def test_teleop_twist_through_the_mux_moves_odom_and_diagnostics_are_aggregated(
     assert messages["/Kobuki/External Power"] == "[0, 1, 0, 0]"
 
     # the filter followed the odometry; the URDF's fixed frames are on /tf_static
-    ekf_x, frame = seen["ekf"]
+    ekf_x, frame, var_x, var_yaw = seen["ekf"]
     assert frame == "odom_combined"
     assert abs(ekf_x - (end[0] - start[0])) < 0.2
+    assert var_x > 0 and var_yaw > 0
+
+    # the base's raw sensors: both wheel encoders counted the drive, battery ~16.5 V, gyro
+    (left0, right0, battery), (left1, right1, _) = seen["core"]
+    driven = end[0] - start[0]
+    ticks = driven / (0.035 * 0.002436916871363930187454)
+    for before, after in ((left0, left1), (right0, right1)):
+        assert abs((after - before) % 65536 - ticks) < 0.2 * ticks + 50
+    assert 160 <= battery <= 165
+    assert seen["imu"][0] == "gyro_link"
     assert {"base_link", "gyro_link", "camera_rgb_frame"} <= set(seen["tf_static"])
     # /tf: odom -> base_footprint from the base, the wheels from joint_states via the URDF
     assert {"base_footprint", "wheel_left_link", "wheel_right_link"} <= set(seen["tf"])
