@@ -608,7 +608,7 @@ def logfatal(msg: Any, *args: Any) -> None:
     _log(logging.CRITICAL, msg, args)
 
 
-logwarn_throttle_state: dict[tuple, float] = {}
+_throttle_state: dict[tuple, float] = {}
 
 
 def loginfo_throttle(period: float, msg: Any, *args: Any) -> None:
@@ -623,6 +623,6 @@ def _throttled(level: int, period: float, msg: Any, args: tuple) -> None:
     frame = inspect.currentframe().f_back.f_back
     key = (frame.f_code.co_filename, frame.f_lineno)
     now = time.monotonic()
-    if now - logwarn_throttle_state.get(key, -1e18) >= period:
-        logwarn_throttle_state[key] = now
+    if now - _throttle_state.get(key, -1e18) >= period:
+        _throttle_state[key] = now
         _log(level, msg, args)

@@ -15,7 +15,6 @@ import select
 import socket
 import struct
 import threading
-import time
 from typing import TYPE_CHECKING, Any, Callable
 
 from orchestra.node import tcpros
@@ -651,11 +650,3 @@ def _refuse(sock: socket.socket, error: str, reason: str) -> None:
     finally:
         sock.close()
 
-
-def wait_until(predicate: Callable[[], bool], timeout: float | None, interval: float = 0.01) -> bool:
-    deadline = None if timeout is None else time.monotonic() + timeout
-    while not predicate():
-        if deadline is not None and time.monotonic() >= deadline:
-            return False
-        time.sleep(interval)
-    return True
