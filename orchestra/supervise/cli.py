@@ -46,6 +46,9 @@ _OPTIONS = [
     click.option("--status/--no-status", "status_view", default=None,
                  help="Live status table under the output (default: on a terminal)."),
     click.option("--with-tests", is_flag=True, help="Also run the <test> nodes (test mode)."),
+    click.option("--no-rosout", is_flag=True,
+                 help="Do not start /rosout with the embedded master (roscore's log "
+                      "aggregator: /rosout_agg and rosout.log)."),
 ]
 
 

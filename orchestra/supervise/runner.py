@@ -4,7 +4,8 @@ The order matters for "nothing half-started": everything that can be the user's 
 (unknown executables, remote machines, bad args) is checked before the master is touched
 or any process is spawned. Then, like roslaunch: use the master at ROS_MASTER_URI when one
 answers (or wait for it with ``--wait``), else start the embedded one; set /run_id, clear
-and upload the parameters, and start the nodes.
+and upload the parameters, and start the nodes (after /rosout when the master is ours, as
+roslaunch starts roscore.xml's node: see rosout.py).
 """
 from __future__ import annotations
 
@@ -53,6 +54,7 @@ class RunOptions:
     log_backups: int = 5
     status_view: bool | None = None
     with_tests: bool = False
+    no_rosout: bool = False
 
     @classmethod
     def from_kwargs(cls, options: Mapping[str, Any]) -> "RunOptions":
@@ -292,6 +294,66 @@ def upload(plan: LaunchPlan, master: MasterConnection) -> None:
     upload_params(master.uri, params, list(plan.clear_params))
 
 
+def check_param_actions(plan: LaunchPlan) -> None:
+    """A ``<rosparam command="dump">`` that cannot write its file, refused before anything
+    starts (roslaunch only fails when it gets there, with the master already up)."""
+    for action in plan.param_actions:
+        if action.command != "dump":
+            continue
+        where = Location(action.filename, action.line) if action.filename else None
+        if not action.file:
+            raise OrchestraError("<rosparam command=\"dump\">: 'file' must be set to dump "
+                                 f"[{action.param}] at launch time", where)
+        folder = os.path.dirname(os.path.abspath(action.file))
+        if not os.path.isdir(folder):
+            raise OrchestraError(f"<rosparam command=\"dump\">: cannot write [{action.file}]: "
+                                 f"no directory {folder}", where)
+
+
+def run_param_actions(plan: LaunchPlan, uri: str, echo) -> None:
+    """roslaunch's setup phase: every ``<rosparam>`` dump and delete, in document order.
+
+    roslaunch runs them after the master is up and BEFORE clear_params and the upload, so
+    a delete clears what an earlier launch left (this launch's params are set afterwards)
+    and a dump writes the server as it was before this launch. As there (where ``rosparam``
+    runs as a child whose exit status is ignored), a missing parameter or an unwritable file
+    is reported and the launch goes on.
+    """
+    if not plan.param_actions:
+        return
+    from orchestra.master.client import TRANSPORT_ERRORS, MasterUnreachable, proxy
+    from orchestra.params.dump import dump_yaml
+
+    server = proxy(uri, timeout=30.0)
+    for action in plan.param_actions:
+        where = f"{action.filename}:{action.line}: " if action.filename else ""
+        try:
+            if action.command == "delete" and action.param == "/":
+                code, message, _ = server.setParam("/roslaunch", "/", {})  # rosparam: empty it
+            elif action.command == "delete":
+                code, message, _ = server.deleteParam("/roslaunch", action.param)
+            else:
+                code, message, value = server.getParam("/roslaunch", action.param)
+        except xmlrpc.client.Fault as exc:
+            code, message = -1, exc.faultString
+        except TRANSPORT_ERRORS as exc:
+            raise MasterUnreachable(f"cannot reach the master at {uri}: {exc}") from None
+        if code != 1:
+            echo(f"orchestra: warning: {where}rosparam {action.command}: {message}")
+            continue
+        if action.command == "delete":
+            echo(f"rosparam delete {action.param}")
+            continue
+        try:
+            with open(action.file or "", "w", encoding="utf-8") as fh:
+                fh.write(dump_yaml(value))
+        except OSError as exc:
+            echo(f"orchestra: warning: {where}rosparam dump: cannot write "
+                 f"[{action.file}]: {exc.strerror}")
+            continue
+        echo(f"rosparam dump {action.param} -> {action.file}")
+
+
 def _is_loopback_uri(uri: str) -> bool:
     host = urllib.parse.urlsplit(uri).hostname or "localhost"
     return host in LOCAL_NAMES or host.startswith("127.")
@@ -324,6 +386,7 @@ def _set_title(title: str) -> None:
 def run_plan(plan: LaunchPlan, options: Mapping[str, Any]) -> int:
     """Run the plan's nodes under supervision until stopped; returns orchestra's exit code."""
     from orchestra.supervise.reaper import Watchdog
+    from orchestra.supervise.rosout import core_nodes, resolve_core_executables
     from orchestra.supervise.rpc import LaunchRPCServer, uris_param
     from orchestra.supervise.status import LiveView, ProcessStats, StatusServer, snapshot
     from orchestra.supervise.supervisor import Supervisor
@@ -334,6 +397,7 @@ def run_plan(plan: LaunchPlan, options: Mapping[str, Any]) -> int:
     _check_unique_names(nodes)
     nodes, remote = split_remote(plan, nodes, opts.local)
     executables = resolve_executables(nodes)
+    check_param_actions(plan)
 
     def echo(text: str) -> None:
         click.echo(text, err=True)
@@ -343,8 +407,13 @@ def run_plan(plan: LaunchPlan, options: Mapping[str, Any]) -> int:
     try:
         master = connect_master(opts, echo)
         run_dir = prepare_run_log_dir(master.run_id)
+        run_param_actions(plan, master.uri, echo)
         upload(plan, master)
-        specs = build_specs(nodes, executables, master.uri, run_dir, opts)
+        core = core_nodes(nodes, master.handle is not None, enabled=not opts.no_rosout)
+        core_exes = resolve_core_executables(core, echo)
+        core = [node for node in core if node.full_name in core_exes]
+        specs = build_specs(core + nodes, {**executables, **core_exes}, master.uri, run_dir,
+                            opts)
         screen = Screen()
         if not opts.disable_title and plan.files_loaded:
             _set_title(" ".join(plan.files_loaded[:1]) + f" {master.uri}")

@@ -149,10 +149,18 @@ class Supervisor:
             return False
         return all(p.state in TERMINAL for p in self.procs)
 
-    def run(self, install_signals: bool = True) -> RunResult:
-        """Start everything and supervise until the run ends; returns the outcome."""
+    def run(self, install_signals: bool = True,
+            before_start: Callable[[], None] | None = None) -> RunResult:
+        """Start everything and supervise until the run ends; returns the outcome.
+
+        ``before_start`` runs once the stop signals are ours and before any spawn: where a
+        caller announces itself (``orchestra core`` prints its URI there, so a Ctrl-C right
+        after it is already an orderly stop).
+        """
         restore = self._install_signals() if install_signals else None
         try:
+            if before_start is not None:
+                before_start()
             self.start_all()
             while not self.done():
                 self.loop.run_once()
