@@ -247,3 +247,32 @@ def test_pure_and_libyaml_composers_read_the_same_entities(loader, monkeypatch):
     err = error_of("launch:\n  - node: {pkg: p\n")
     assert err.message.startswith("invalid YAML") and err.location.line is not None
     assert "not allowed" in error_of("launch: [{param: !!python/name:os.system x}]\n").message
+
+
+def _orchestra(*args):
+    import subprocess
+    import sys
+
+    return subprocess.run([sys.executable, "-m", "orchestra", *args], capture_output=True,
+                          text=True, timeout=60)
+
+
+def test_orchestra_launch_reads_yaml_files():
+    import json
+
+    from conftest import REPO
+
+    proc = _orchestra("launch", "--dump-plan", "--no-exec",
+                      str(REPO / "launch" / "turtle_tf_demo.launch.yaml"))
+    assert proc.returncode == 0, proc.stderr
+    plan = json.loads(proc.stdout)
+    assert [n["name"] for n in plan["nodes"]][:2] == ["sim", "teleop"]
+
+
+def test_orchestra_launch_reports_bad_yaml_as_one_located_line(tmp_path):
+    path = tmp_path / "bad.launch.yaml"
+    path.write_text("launch:\n  - node: !!python/object:os.system {pkg: p}\n")
+    proc = _orchestra("launch", "--dump-plan", "--no-exec", str(path))
+    assert proc.returncode == 2
+    assert proc.stderr.startswith(f"orchestra: error: {path}:2:11: YAML tag")
+    assert "Traceback" not in proc.stderr
