@@ -277,3 +277,16 @@ def test_uri_alive_tells_a_listening_port_from_a_closed_one():
     server.close()
     assert not uri_alive(f"http://127.0.0.1:{port}/")
     assert uri_alive("not a uri")   # unknown: never unload on a guess
+
+
+def test_tcpros_copies_of_this_process_messages_are_not_delivered_twice():
+    from nodelet.base import from_other_process
+
+    class Msg:
+        __slots__ = ("_connection_header",)
+    msg = Msg()
+    assert from_other_process(msg, "/mgr")            # no header: not ours
+    msg._connection_header = {"callerid": "/teleop"}
+    assert from_other_process(msg, "/mgr")
+    msg._connection_header = {"callerid": "/mgr"}
+    assert not from_other_process(msg, "/mgr")

@@ -18,6 +18,14 @@ from nodelet.local import BUS, NodeletPublisher
 _MISSING = object()
 
 
+def from_other_process(msg: Any, own_node: str) -> bool:
+    """False for a TCPROS message this very process published: the local bus delivered it
+    already. (orchestra.node does not connect a process to itself today; this keeps a
+    message from arriving twice should that ever change.)"""
+    header = getattr(msg, "_connection_header", None) or {}
+    return header.get("callerid") != own_node
+
+
 class Timer:
     """Calls ``callback(now_seconds)`` every ``period`` seconds on its own thread until stopped."""
 
@@ -141,7 +149,12 @@ class Nodelet:
         resolved = self.resolve(topic)
         # other nodelets of this process publish through the local bus, the rest over TCPROS
         self._keep(BUS.subscribe(resolved, msg_class._type, callback, queue_size))
-        return self._keep(node.Subscriber(resolved, msg_class, callback, queue_size=queue_size))
+        own = node.get_name()
+
+        def remote(msg: Any) -> None:
+            if from_other_process(msg, own):
+                callback(msg)
+        return self._keep(node.Subscriber(resolved, msg_class, remote, queue_size=queue_size))
 
     def advertise_service(self, name: str, srv_class: type,
                           handler: Callable[[Any], Any]) -> Any:
