@@ -23,7 +23,7 @@ from orchestra.errors import Location, OrchestraError
 from orchestra.launch.context import Scope, ScopeError
 from orchestra.launch.entity import Entity
 from orchestra.launch.files import read_bytes, read_text
-from orchestra.launch.plan import LaunchPlan, Machine, Node, Test
+from orchestra.launch.plan import LaunchPlan, Machine, Node, ParamAction, Test
 from orchestra.launch.substitution import ArgNotSet, SubstitutionError, resolve
 from orchestra.launch.values import bool_attribute, convert_value, float_attribute
 from orchestra.names import (canonicalize, is_legal_name, is_private, make_global_ns,
@@ -103,6 +103,7 @@ class Interpreter:
         self.options = options or LoadOptions()
         self.params: dict[str, Any] = {}
         self.clear_params: list[str] = []
+        self.param_actions: list[ParamAction] = []
         self.nodes: list[Node] = []
         self.tests: list[Test] = []
         self.machines: dict[str, Machine] = {"": Machine(name="")}
@@ -135,7 +136,8 @@ class Interpreter:
     def plan(self) -> LaunchPlan:
         return LaunchPlan(params=self.params, clear_params=tuple(self.clear_params),
                           nodes=tuple(self.nodes), tests=tuple(self.tests),
-                          machines=self.machines, files_loaded=tuple(self.files))
+                          machines=self.machines, files_loaded=tuple(self.files),
+                          param_actions=tuple(self.param_actions))
 
     # ================================================================ helpers
     def _error(self, entity: Entity, message: str, attr: str | None = None) -> LaunchError:
@@ -467,7 +469,7 @@ class Interpreter:
                 raise self._error(entity, "'file' is invalid with command='delete'", "file")
         full = ns_join(scope.ns, param) if param else scope.ns
         if cmd != "load":
-            log.debug("rosparam %s %s ignored while resolving", cmd, full)
+            self._param_action(entity, cmd, full, file_)
             return None
         source = file_ or entity.location.file
         if file_:
@@ -496,6 +498,21 @@ class Interpreter:
             raise self._error(entity, "'param' must be set for non-dictionary values", "param")
         self._add_rosparam(entity, full, data)
         return None
+
+    def _param_action(self, entity: Entity, cmd: str, full: str, file_: str | None) -> None:
+        """Record a dump/delete for launch time (roslaunch runs ``rosparam`` then).
+
+        roslaunch hands the name to the rosparam tool, which resolves a private ``~name``
+        under its own node name ``/rosparam``; the name is resolved here the same way, once.
+        """
+        if is_private(full):
+            resolved = canonicalize(ns_join("/rosparam/", full[1:]))
+            self._warn(entity, f"private name '{full}' in <rosparam command=\"{cmd}\"> means "
+                       f"[{resolved}] (rosparam resolves it under its own node name)")
+            full = resolved
+        self.param_actions.append(ParamAction(
+            command=cmd, param=canonicalize(full), file=file_,
+            filename=entity.location.file, line=entity.location.line))
 
     def _add_rosparam(self, entity: Entity, name: str, value: Any) -> None:
         if name == "/" and not isinstance(value, dict):

@@ -103,6 +103,30 @@ class Test(Node):
         return data
 
 
+@dataclass(frozen=True)
+class ParamAction:
+    """A ``<rosparam command="dump">`` or ``command="delete"``, carried out at launch time.
+
+    roslaunch turns these into ``rosparam dump FILE NS`` / ``rosparam delete NAME`` commands
+    run in its setup phase: after the master is up, BEFORE clear_params and the parameter
+    upload, in document order. So a delete removes what an earlier run left on the server
+    (the launch's own params are set afterwards) and a dump records the server as it was
+    before this launch's params. ``param`` is the full name (the namespace, for a dump);
+    ``file`` is the dump file as written (a relative path is relative to the working
+    directory of the launch), None for a delete.
+    """
+
+    command: str
+    param: str
+    file: str | None = None
+    filename: str | None = None
+    line: int | None = None
+
+    def to_json(self) -> dict[str, Any]:
+        return {"command": self.command, "param": self.param, "file": self.file,
+                "filename": self.filename, "line": self.line}
+
+
 def _freeze(mapping: Mapping[str, Any]) -> Mapping[str, Any]:
     return MappingProxyType(dict(mapping))
 
@@ -114,7 +138,8 @@ class LaunchPlan:
     ``params`` maps full parameter names to values exactly as roslaunch would store them on the
     parameter server (rosparam dicts flattened to leaves; ``type="yaml"`` values whole; a
     ``command=`` param not executed is ``{"__command__": cmd}``). ``clear_params`` are
-    namespaces to clear, in order, before the upload.
+    namespaces to clear, in order, before the upload. ``param_actions`` are the
+    ``<rosparam>`` dumps and deletes, in document order, run before both (see ParamAction).
     """
 
     params: Mapping[str, Any] = field(default_factory=dict)
@@ -123,6 +148,7 @@ class LaunchPlan:
     tests: tuple[Test, ...] = ()
     machines: Mapping[str, Machine] = field(default_factory=dict)
     files_loaded: tuple[str, ...] = ()
+    param_actions: tuple[ParamAction, ...] = ()
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "params", _freeze(self.params))
@@ -144,4 +170,5 @@ class LaunchPlan:
             "tests": [t.to_json() for t in self.tests],
             "machines": {name: m.to_json() for name, m in self.machines.items()},
             "files_loaded": list(self.files_loaded),
+            "param_actions": [a.to_json() for a in self.param_actions],
         }
