@@ -354,66 +354,6 @@ def run_param_actions(plan: LaunchPlan, uri: str, echo) -> None:
         echo(f"rosparam dump {action.param} -> {action.file}")
 
 
-def check_param_actions(plan: LaunchPlan) -> None:
-    """A ``<rosparam command="dump">`` that cannot write its file, refused before anything
-    starts (roslaunch only fails when it gets there, with the master already up)."""
-    for action in plan.param_actions:
-        if action.command != "dump":
-            continue
-        where = Location(action.filename, action.line) if action.filename else None
-        if not action.file:
-            raise OrchestraError("<rosparam command=\"dump\">: 'file' must be set to dump "
-                                 f"[{action.param}] at launch time", where)
-        folder = os.path.dirname(os.path.abspath(action.file))
-        if not os.path.isdir(folder):
-            raise OrchestraError(f"<rosparam command=\"dump\">: cannot write [{action.file}]: "
-                                 f"no directory {folder}", where)
-
-
-def run_param_actions(plan: LaunchPlan, uri: str, echo) -> None:
-    """roslaunch's setup phase: every ``<rosparam>`` dump and delete, in document order.
-
-    roslaunch runs them after the master is up and BEFORE clear_params and the upload, so
-    a delete clears what an earlier launch left (this launch's params are set afterwards)
-    and a dump writes the server as it was before this launch. As there (where ``rosparam``
-    runs as a child whose exit status is ignored), a missing parameter or an unwritable file
-    is reported and the launch goes on.
-    """
-    if not plan.param_actions:
-        return
-    from orchestra.master.client import TRANSPORT_ERRORS, MasterUnreachable, proxy
-    from orchestra.params.dump import dump_yaml
-
-    server = proxy(uri, timeout=30.0)
-    for action in plan.param_actions:
-        where = f"{action.filename}:{action.line}: " if action.filename else ""
-        try:
-            if action.command == "delete" and action.param == "/":
-                code, message, _ = server.setParam("/roslaunch", "/", {})  # rosparam: empty it
-            elif action.command == "delete":
-                code, message, _ = server.deleteParam("/roslaunch", action.param)
-            else:
-                code, message, value = server.getParam("/roslaunch", action.param)
-        except xmlrpc.client.Fault as exc:
-            code, message = -1, exc.faultString
-        except TRANSPORT_ERRORS as exc:
-            raise MasterUnreachable(f"cannot reach the master at {uri}: {exc}") from None
-        if code != 1:
-            echo(f"orchestra: warning: {where}rosparam {action.command}: {message}")
-            continue
-        if action.command == "delete":
-            echo(f"rosparam delete {action.param}")
-            continue
-        try:
-            with open(action.file or "", "w", encoding="utf-8") as fh:
-                fh.write(dump_yaml(value))
-        except OSError as exc:
-            echo(f"orchestra: warning: {where}rosparam dump: cannot write "
-                 f"[{action.file}]: {exc.strerror}")
-            continue
-        echo(f"rosparam dump {action.param} -> {action.file}")
-
-
 def _is_loopback_uri(uri: str) -> bool:
     host = urllib.parse.urlsplit(uri).hostname or "localhost"
     return host in LOCAL_NAMES or host.startswith("127.")
@@ -458,7 +398,6 @@ def run_plan(plan: LaunchPlan, options: Mapping[str, Any]) -> int:
     nodes, remote = split_remote(plan, nodes, opts.local)
     executables = resolve_executables(nodes)
     check_param_actions(plan)
-    check_param_actions(plan)
 
     def echo(text: str) -> None:
         click.echo(text, err=True)
@@ -468,7 +407,6 @@ def run_plan(plan: LaunchPlan, options: Mapping[str, Any]) -> int:
     try:
         master = connect_master(opts, echo)
         run_dir = prepare_run_log_dir(master.run_id)
-        run_param_actions(plan, master.uri, echo)
         run_param_actions(plan, master.uri, echo)
         upload(plan, master)
         core = core_nodes(nodes, master.handle is not None, enabled=not opts.no_rosout)
