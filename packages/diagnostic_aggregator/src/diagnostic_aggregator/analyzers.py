@@ -2,16 +2,20 @@
 
 Rules kept from the real aggregator because robot dashboards depend on them:
 
-* every raw status is claimed by the FIRST analyzer (in configuration order) that matches it;
-  unclaimed ones go to ``Other``;
-* a GenericAnalyzer matches by ``name`` (exact), ``startswith``, ``contains``, ``regex`` or
-  ``expected``; it renames an item to ``<base_path>/<path>/<name minus remove_prefix>``
-  (a leading ``:`` and spaces after the prefix go too: a C++ diagnostic updater names its
-  tasks ``"<node>: <task>"``);
-* an item not updated for ``timeout`` seconds is stale (level 3), an ``expected`` item never
-  seen is reported stale as "Missing"; the analyzer's own header status has the worst level
-  of its items, except that a mix of stale and fresh items is an Error, and all stale is
-  Stale ("All Stale"); ``discard_stale`` drops stale items instead of reporting them.
+* a raw status goes to EVERY analyzer that matches it; statuses no analyzer takes go to
+  ``Other`` (reported only while it holds items, which it drops 5 s after their last update);
+* a GenericAnalyzer matches by ``name`` (exact), ``startswith``, ``contains``, ``regex``
+  (whole name) or ``expected``, and needs at least one of them; it shows an item as
+  ``<base_path>/<path>/<name>`` with ``/`` in the name turned into spaces and the first
+  matching ``remove_prefix`` cut from its start together with a following ``:`` and spaces
+  (a C++ diagnostic updater names its tasks ``"<node>: <task>"``);
+* an item not updated for ``timeout`` seconds is stale (level 3); an ``expected`` item is
+  listed from the start, as stale "Missing", until it reports;
+* an analyzer's header has the worst level of its items, but stale items make it Error
+  unless every item is stale (then Stale; an analyzer without items is Stale too);
+  ``num_items`` makes a different count an Error ("Expected N, found M");
+* a group's header combines its members' headers by the same rule; the top-level state is
+  the worst level of everything published, stale counting as Error unless all is stale.
 """
 from __future__ import annotations
 
@@ -45,6 +49,11 @@ def join_path(*parts: str) -> str:
     return "/" + "/".join(pieces)
 
 
+def output_name(name: str) -> str:
+    """An item name as shown under its analyzer's path: slashes would fake a deeper tree."""
+    return name.replace("/", " ")
+
+
 def remove_leading_chaff(name: str, chaff: str) -> str:
     """``name`` with ``chaff`` removed from the start of its last path element, then a
     leading ``:`` and spaces (``"base_manager: Battery"`` -> ``"Battery"``)."""
@@ -67,28 +76,25 @@ def _as_list(value: object) -> list[str]:
     return [str(value)]
 
 
-def _combine(levels: list[int]) -> tuple[int, str]:
-    """The header level/message for a group of item levels (stale rules above)."""
-    if not levels:
-        return OK, "OK"
-    worst = max(levels)
-    all_stale = all(level == STALE for level in levels)
+def _combine(levels: list[int], all_stale: bool) -> int:
+    """A header level: the worst level, stale meaning Error unless everything is stale."""
     if all_stale:
-        return STALE, "All Stale"
-    if worst == STALE:
-        return ERROR, LEVEL_TEXT[ERROR]
-    return worst, LEVEL_TEXT[worst]
+        return STALE
+    worst = max(levels, default=OK)
+    return ERROR if worst == STALE else worst
 
 
 class Analyzer:
-    """Common interface: ``match``/``analyze`` claim raw statuses, ``report`` builds output."""
+    """Common interface: ``match``/``analyze`` take raw statuses, ``report`` builds output
+    whose first status is the analyzer's header (named ``path``)."""
 
     path: str
+    nice_name: str
 
     def match(self, name: str) -> bool:
         raise NotImplementedError
 
-    def analyze(self, status: Status, now: float) -> None:
+    def analyze(self, status: Status, now: float) -> bool:
         raise NotImplementedError
 
     def report(self, now: float) -> list[Status]:
@@ -102,6 +108,7 @@ class GenericAnalyzer(Analyzer):
                  discard_stale: bool = False):
         if not path:
             raise AnalyzerConfigError("GenericAnalyzer needs a 'path'")
+        self.nice_name = path
         self.path = join_path(base_path, path)
         self.contains = _as_list(contains)
         self.startswith = _as_list(startswith) + _as_list(find_and_remove_prefix)
@@ -111,71 +118,113 @@ class GenericAnalyzer(Analyzer):
             self.regex = [re.compile(r) for r in _as_list(regex)]
         except re.error as exc:
             raise AnalyzerConfigError(f"GenericAnalyzer '{path}': bad regex: {exc}") from None
-        self.chaff = _as_list(remove_prefix) + _as_list(find_and_remove_prefix)
+        if not (self.contains or self.startswith or self.names or self.expected or self.regex):
+            raise AnalyzerConfigError(f"GenericAnalyzer '{path}' has no way to match items "
+                                      "(give contains, startswith, name, expected or regex)")
+        self.chaff = [output_name(c) for c in
+                      _as_list(remove_prefix) + _as_list(find_and_remove_prefix)]
         self.timeout = float(timeout)
         self.num_items = int(num_items)
         self.discard_stale = bool(discard_stale)
-        self.items: dict[str, tuple[Status, float]] = {}
+        # expected items are listed from the start: stale and "Missing" until they report
+        self.items: dict[str, tuple[Status, float | None]] = {
+            e: (Status(STALE, e, "Missing"), None) for e in self.expected}
 
     def match(self, name: str) -> bool:
         return (name in self.names or name in self.expected
                 or any(name.startswith(s) for s in self.startswith)
                 or any(s in name for s in self.contains)
-                or any(r.search(name) for r in self.regex))
+                or any(r.fullmatch(name) for r in self.regex))
 
-    def analyze(self, status: Status, now: float) -> None:
+    def analyze(self, status: Status, now: float) -> bool:
         self.items[status.name] = (status, now)
+        return True
 
     def output_name(self, name: str) -> str:
+        shown = output_name(name)
         for chaff in self.chaff:
-            stripped = remove_leading_chaff(name, chaff)
-            if stripped != name:
-                name = stripped
+            stripped = remove_leading_chaff(shown, chaff)
+            if stripped != shown:
+                shown = stripped
                 break
-        return join_path(self.path, name)
+        return join_path(self.path, shown)
+
+    def _stale(self, seen: float | None, now: float) -> bool:
+        if seen is None:
+            return True
+        return self.timeout > 0 and now - seen > self.timeout
 
     def report(self, now: float) -> list[Status]:
         out: list[Status] = []
-        for raw_name, (status, seen) in sorted(self.items.items()):
-            stale = self.timeout > 0 and now - seen > self.timeout
+        header = Status(OK, self.path, "OK")
+        levels: list[int] = []
+        all_stale = True
+        for raw_name in sorted(self.items):
+            status, seen = self.items[raw_name]
+            stale = self._stale(seen, now)
             if stale and self.discard_stale:
+                del self.items[raw_name]
                 continue
-            out.append(Status(STALE if stale else status.level, self.output_name(raw_name),
-                              status.message, status.hardware_id, list(status.values)))
-        for expected in self.expected:
-            if expected not in self.items:
-                out.append(Status(STALE, self.output_name(expected), "Missing"))
-        level, message = _combine([s.level for s in out])
-        if self.num_items > 0 and len(out) != self.num_items:
-            level, message = ERROR, f"Expected {self.num_items}, found {len(out)}"
-        if not out and self.timeout > 0 and not self.discard_stale:
-            level, message = STALE, "No items"
-        header = Status(level, self.path, message,
-                        values=[(s.name.rsplit("/", 1)[-1], s.message) for s in out])
+            level = STALE if stale else status.level
+            levels.append(level)
+            all_stale = all_stale and level == STALE
+            header.values.append((raw_name, status.message))
+            out.append(Status(level, self.output_name(raw_name), status.message,
+                              status.hardware_id, list(status.values)))
+        header.level = _combine(levels, all_stale)
+        header.message = LEVEL_TEXT[header.level]
+        if self.num_items > 0 and len(self.items) != self.num_items:
+            header.level = max(ERROR, header.level)
+            header.message = (f"Expected {self.num_items}, found {len(self.items)}" if self.items
+                              else f"No items, expected {self.num_items}")
+        missing = [e for e in self.expected if e not in self.items]  # dropped as stale
+        if missing:
+            everything_stale = all(s.level == STALE for s in out) and header.level == STALE
+            header.level, header.message = ((STALE, "All Stale") if everything_stale
+                                            else (ERROR, "Error"))
+            for name in missing:
+                out.append(Status(STALE, self.output_name(name), "Missing"))
+                header.values.append((name, "Missing"))
         return [header] + out
 
 
 class AnalyzerGroup(Analyzer):
-    """Analyzers under a common path; the group's header is the worst of its members'."""
+    """Analyzers under a common path; the group's header combines its members' headers.
+    The aggregator's root is a group at ``base_path`` (no header when that is empty)."""
 
     def __init__(self, path: str, analyzers: list[Analyzer], base_path: str = ""):
-        self.path = join_path(base_path, path)
+        self.nice_name = path
+        self.path = join_path(base_path, path) if path else join_path(base_path)
         self.analyzers = analyzers
 
     def match(self, name: str) -> bool:
         return any(a.match(name) for a in self.analyzers)
 
-    def analyze(self, status: Status, now: float) -> None:
+    def analyze(self, status: Status, now: float) -> bool:
+        taken = False
         for analyzer in self.analyzers:
             if analyzer.match(status.name):
-                analyzer.analyze(status, now)
-                return
+                taken = analyzer.analyze(status, now) or taken
+        return taken
 
     def report(self, now: float) -> list[Status]:
-        reports = [a.report(now) for a in self.analyzers]
-        level, message = _combine([r[0].level for r in reports if r])
-        header = Status(level, self.path, message)
-        return [header] + [s for r in reports for s in r]
+        header = Status(OK, self.path, "OK")
+        if not self.analyzers:
+            header.level, header.message = ERROR, "No analyzers"
+            return [header]
+        out: list[Status] = []
+        levels: list[int] = []
+        for analyzer in self.analyzers:
+            statuses = analyzer.report(now)
+            out.extend(statuses)
+            if statuses and statuses[0].name == analyzer.path:
+                levels.append(statuses[0].level)
+                header.values.append((analyzer.nice_name, statuses[0].message))
+        header.level = _combine(levels, bool(levels) and all(lv == STALE for lv in levels))
+        header.message = LEVEL_TEXT[header.level]
+        if self.path == "/":
+            return out  # the root group of an aggregator without base_path has no header
+        return [header] + out
 
 
 def build_analyzer(key: str, spec: object, base_path: str) -> Analyzer:
@@ -211,33 +260,27 @@ def build_analyzers(specs: object, base_path: str = "") -> list[Analyzer]:
 
 
 class Aggregator:
-    """Routes raw statuses to analyzers and produces one aggregated array per tick."""
+    """Routes raw statuses to the analyzers (or Other) and reports the whole tree."""
 
     def __init__(self, analyzers: list[Analyzer], base_path: str = "",
                  other_timeout: float = 5.0):
-        self.analyzers = analyzers
+        self.root = AnalyzerGroup("", analyzers, base_path)
         self.other = GenericAnalyzer("Other", base_path, regex=".*", timeout=other_timeout,
                                      discard_stale=True)
         self.base_path = base_path
 
     def add(self, status: Status, now: float) -> None:
-        for analyzer in self.analyzers:
-            if analyzer.match(status.name):
-                analyzer.analyze(status, now)
-                return
-        self.other.analyze(status, now)
+        if not (self.root.match(status.name) and self.root.analyze(status, now)):
+            self.other.analyze(status, now)
 
     def report(self, now: float) -> tuple[list[Status], Status]:
         """(every output status, the top-level state)."""
-        out: list[Status] = []
-        headers: list[int] = []
-        for analyzer in self.analyzers:
-            statuses = analyzer.report(now)
-            headers.append(statuses[0].level)
-            out.extend(statuses)
+        out = self.root.report(now) if self.root.analyzers else []
         other = self.other.report(now)
         if len(other) > 1:  # Other appears only while something is unclaimed
             out.extend(other)
-            headers.append(other[0].level)
-        level, message = _combine(headers)
-        return out, Status(level, "toplevel_state", message)
+        levels = [s.level for s in out]
+        level = max(levels, default=OK)
+        if level == STALE and min(levels) <= ERROR:
+            level = ERROR
+        return out, Status(level, "toplevel_state", LEVEL_TEXT[level])
