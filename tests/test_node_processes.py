@@ -329,3 +329,25 @@ def test_slow_subscriber_with_queue_size_one_skips_to_the_newest_message(nodes):
     received = [d["msg"]["data"] for d in sub.seen if "msg" in d]
     assert last and received == sorted(received)
     assert len(received) < 50  # most of the backlog was dropped, not queued
+
+
+def test_garbage_and_unknown_requests_on_the_tcpros_port_do_not_hurt_the_node(nodes):
+    pub = nodes.start("pub.py", "sturdy", "std_msgs/String", "data: ok", "--name", "sturdy")
+    pub.ready()
+    master = xmlrpc.client.ServerProxy(nodes.master_uri)
+    api = xmlrpc.client.ServerProxy(wait_for(lambda: master.lookupNode("/t", "/sturdy")[2]))
+    _, _, (_, host, port) = api.requestTopic("/t", "/sturdy", [["TCPROS"]])
+    with socket.create_connection((host, port)) as sock:  # absurd header length
+        sock.sendall(b"\xff\xff\xff\x7f garbage")
+    with tcpros.connect(host, port) as sock:  # neither topic nor service
+        tcpros.write_header(sock, {"callerid": "/t"})
+        assert "error" in tcpros.read_header(sock)
+    with tcpros.connect(host, port) as sock:  # a topic it does not publish
+        tcpros.write_header(sock, {"callerid": "/t", "topic": "/other", "md5sum": "*"})
+        assert "/other" in tcpros.read_header(sock)["error"]
+    with tcpros.connect(host, port) as sock:  # an unknown service
+        tcpros.write_header(sock, {"callerid": "/t", "service": "/nope", "md5sum": "*"})
+        assert "/nope" in tcpros.read_header(sock)["error"]
+    sub = nodes.start("sub.py", "sturdy", "std_msgs/String")
+    assert sub.messages() == {"data": "ok"}
+    assert pub.proc.poll() is None
