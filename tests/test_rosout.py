@@ -89,20 +89,31 @@ def test_log_file_rotates_past_max_size_keeping_max_backups(tmp_path):
     log.close()
     names = sorted(p.name for p in path.parent.iterdir())
     assert names == ["rosout.log", "rosout.log.1", "rosout.log.2"]
-    # 39-byte lines: every third one passes 100 bytes and starts a new file
+    # banner 27 bytes, then 39-byte lines: every third one passes 100 bytes, a new file
     assert [line[:7] for line in (path.parent / "rosout.log.1").read_text().splitlines()] == [
         "line 17", "line 18", "line 19"]
     assert (path.parent / "rosout.log.2").read_text().startswith("line 14")
     assert path.read_text() == ""
 
 
-def test_log_file_is_truncated_at_start_like_rosout(tmp_path):
+def test_restarted_rosout_appends_after_a_new_banner(tmp_path):
     path = tmp_path / "rosout.log"
-    path.write_text("old run\n")
+    path.write_text("1.000000000 INFO /a [f:1(g)] [topics: ] before the respawn\n")
     log = RosoutLog(str(path))
-    log.open(startup_banner(1, 0))
+    log.open(startup_banner(2, 0))
     log.close()
-    assert path.read_text() == "\n\n1.000000000  Node Startup\n"
+    assert path.read_text() == ("1.000000000 INFO /a [f:1(g)] [topics: ] before the respawn\n"
+                                "\n\n2.000000000  Node Startup\n")
+
+
+def test_appending_counts_the_existing_size_towards_rotation(tmp_path):
+    path = tmp_path / "rosout.log"
+    path.write_text("x" * 90 + "\n")
+    log = RosoutLog(str(path), max_bytes=100, max_backups=1)
+    log.open()
+    log.write("0123456789\n")
+    log.close()
+    assert path.read_text() == "" and (tmp_path / "rosout.log.1").stat().st_size == 102
 
 
 def test_aggregator_republishes_then_writes_each_message(tmp_path):

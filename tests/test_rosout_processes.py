@@ -117,6 +117,14 @@ def test_loginfo_reaches_rosout_agg_and_rosout_log_with_embedded_master(env, spa
     line = next(line for line in lines if "hello from talker" in line)
     assert line.split(" ")[1:3] == ["INFO", "/talker"]
     assert f"[{env['talker']}:" in line and "[topics: /rosout]" in line
+    # respawn="true" as in roscore.xml: a killed rosout comes back and appends to its file
+    pid = int(out.read_text().split("process[/rosout]: started with pid [")[1].split("]")[0])
+    os.kill(pid, signal.SIGKILL)
+    wait_for_file_text(out, "process[/rosout]: died")
+    assert "hello from talker" in echo_one(env["env"])
+    content = wait_for_file_text(latest / "rosout.log", "Node Startup", timeout=5)
+    assert content.count("Node Startup") == 2 and content.index("hello from talker") < \
+        content.rindex("Node Startup")
     assert stop(launch) == 0
     text = out.read_text()
     # /rosout started before the plan's node and counted first, as roslaunch's core node

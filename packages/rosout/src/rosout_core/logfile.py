@@ -6,8 +6,8 @@ them::
     1700000000.012345678 INFO /talker [talker.py:12(main)] [topics: /rosout, /chatter] hi
 
 that is ``<stamp secs.nsecs> <LEVEL> <node> [<file>:<line>(<function>)] [topics: a, b] <msg>``,
-the ``[topics: ...]`` part left out when the ``/rosout/omit_topics`` parameter is true. A
-fresh file starts with two empty lines and ``<now>  Node Startup``. Past ``max_bytes`` the file
+the ``[topics: ...]`` part left out when the ``/rosout/omit_topics`` parameter is true. Each
+start adds two empty lines and ``<now>  Node Startup``. Past ``max_bytes`` the file
 is rotated ``rosout.log -> rosout.log.1 -> ... -> rosout.log.<max_backups>`` (the oldest
 dropped), checked after each write, as rosout does.
 """
@@ -103,8 +103,8 @@ def plan_rotation(path: str, backups: int, max_backups: int) -> Rotation:
 
 @dataclass
 class RosoutLog:
-    """The open rosout.log: truncated at start (as rosout), flushed after every line so the
-    file is complete whenever someone reads it, rotated past ``max_bytes`` (0 = never).
+    """The open rosout.log: appended to, flushed after every line so the file is complete
+    whenever someone reads it, rotated past ``max_bytes`` (0 = never).
 
     I/O errors are logged and do not stop the node: aggregation on /rosout_agg matters more
     than the file.
@@ -118,13 +118,16 @@ class RosoutLog:
     _fh: BinaryIO | None = field(default=None, repr=False)
 
     def open(self, banner: str = "") -> None:
+        """Open for appending: a respawned rosout (or a second run with the same run id)
+        continues the file after its ``Node Startup`` banner instead of wiping what the
+        previous instance wrote, which roscpp's rosout does."""
         os.makedirs(os.path.dirname(self.path) or ".", exist_ok=True)
-        self._fh = open(self.path, "wb")
-        self.size = 0
+        self._fh = open(self.path, "ab")
+        self.size = self._fh.tell()
         if banner:
-            self.write(banner, rotate=False)
+            self.write(banner)
 
-    def write(self, text: str, rotate: bool = True) -> None:
+    def write(self, text: str) -> None:
         if self._fh is None:
             return
         data = text.encode("utf-8", "replace")
@@ -135,7 +138,7 @@ class RosoutLog:
             logger.error("cannot write %s: %s", self.path, exc)
             return
         self.size += len(data)
-        if rotate and self.max_bytes and self.size > self.max_bytes:
+        if self.max_bytes and self.size > self.max_bytes:
             self.rotate()
 
     def rotate(self) -> None:
@@ -144,7 +147,7 @@ class RosoutLog:
         _apply(step)
         self.backups = step.backups
         try:
-            self._fh = open(self.path, "wb")
+            self._fh = open(self.path, "ab")
         except OSError as exc:
             logger.error("cannot reopen %s after rotation: %s", self.path, exc)
             self._fh = None
