@@ -123,16 +123,23 @@ def run_loader(type_name: str, manager_name: str, extra: list[str]) -> int:
         return 1
     node.loginfo("nodelet %s (%s) loaded into %s", name, type_name, manager)
 
-    code = 0
+    code, unload_at_exit = 0, True
     while not stop.wait(WATCH_PERIOD):
+        if node.is_shutdown():
+            # the master shut us down: a new node took our name and owns the nodelet now
+            unload_at_exit = False
+            break
         # the manager going away takes our nodelet with it: say so and exit (ROS's bond)
         try:
             node.wait_for_service(load_name, timeout=WATCH_PERIOD)
         except node.ROSException:
+            if node.is_shutdown():
+                unload_at_exit = False
+                break
             node.logerr("nodelet manager %s went away; nodelet %s is gone", manager, name)
-            code = 1
+            code, unload_at_exit = 1, False
             break
-    if code == 0:
+    if unload_at_exit:
         unload = node.ServiceProxy(unload_name, _srv("nodelet/NodeletUnload"))
         outcome = _call_with_timeout(lambda: unload(name=name), 2.0)
         if outcome is None or isinstance(outcome, Exception):
