@@ -153,10 +153,12 @@ PROBE = textwrap.dedent('''
 def bringup(tmp_path):
     port = free_port()
     env = clean_env(tmp_path, ROS_MASTER_URI=f"http://127.0.0.1:{port}/")
+    log = open(tmp_path / "launch.log", "w")  # a file, not a pipe nobody drains
     proc = subprocess.Popen([sys.executable, "-m", "orchestra", "launch", "turtlebot_bringup",
-                             "minimal.launch"], env=env, stdout=subprocess.PIPE,
-                            stderr=subprocess.STDOUT, text=True, start_new_session=True)
+                             "minimal.launch"], env=env, stdout=log, stderr=subprocess.STDOUT,
+                            text=True, start_new_session=True)
     yield proc, env
+    log.close()
     if proc.poll() is None:
         proc.send_signal(signal.SIGINT)
         try:
@@ -215,6 +217,7 @@ def test_teleop_twist_through_the_mux_moves_odom_and_diagnostics_are_aggregated(
 
     # Ctrl-C stops the whole bring-up cleanly
     proc.send_signal(signal.SIGINT)
-    output, _ = proc.communicate(timeout=20)
+    proc.wait(timeout=20)
+    output = (tmp_path / "launch.log").read_text()
     assert proc.returncode == 0, output
     assert "kinect_breaker_enabler]: has finished cleanly" in output
