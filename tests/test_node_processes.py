@@ -351,3 +351,9 @@ def test_garbage_and_unknown_requests_on_the_tcpros_port_do_not_hurt_the_node(no
     sub = nodes.start("sub.py", "sturdy", "std_msgs/String")
     assert sub.messages() == {"data": "ok"}
     assert pub.proc.poll() is None
+
+
+def test_a_node_receives_its_own_publications_like_rospy(nodes):
+    proc = nodes.start("echo_self.py")
+    assert proc.expect(lambda d: "got" in d)["got"] == ["mine", "/self_loop"]
+    assert proc.wait() == 0

@@ -427,7 +427,7 @@ class Subscription:
         with self.lock:
             if self.closed:
                 return
-            wanted = [u for u in dict.fromkeys(uris) if u != self.runtime.uri]
+            wanted = list(dict.fromkeys(uris))
             gone = [] if additive else [u for u in self.connections if u not in wanted]
             for uri in gone:
                 self.connections.pop(uri).close()
