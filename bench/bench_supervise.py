@@ -87,7 +87,9 @@ def cold_start_and_idle_cpu(n: int, idle: float) -> dict[str, float]:
         while True:
             try:
                 doc = query(sock_path)
-                if sum(1 for node in doc["nodes"] if node["state"] == "RUNNING") == n:
+                # the plan's n nodes (/rosout, started with the embedded master, not counted)
+                if sum(1 for node in doc["nodes"]
+                       if node["state"] == "RUNNING" and node["name"] != "/rosout") == n:
                     break
             except (OSError, ValueError):
                 pass
