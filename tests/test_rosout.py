@@ -17,7 +17,7 @@ from rosout_core.logfile import (RosoutLog, format_line, format_stamp, level_nam
 
 from orchestra.launch.plan import Node  # noqa: E402
 from orchestra.supervise.rosout import ROSOUT, core_nodes, resolve_core_executables  # noqa: E402
-from orchestra.supervise.runner import RunOptions, build_specs  # noqa: E402
+from orchestra.supervise.runner import RunOptions, run_specs  # noqa: E402
 
 
 def log_msg(level=2, name="/talker", text="hello", topics=("/rosout", "/chatter"),
@@ -156,10 +156,18 @@ def test_bundled_rosout_is_found_and_counts_first_like_roslaunch(tmp_path):
     exes = resolve_core_executables([ROSOUT], pytest.fail)
     assert exes["/rosout"].endswith("rosout")
     talker = Node("demo", "talker", "talker")
-    specs = build_specs([ROSOUT, talker], {**exes, "/talker": "/bin/true"},
-                        "http://127.0.0.1:1/", str(tmp_path), RunOptions())
+    specs = run_specs([ROSOUT], [talker], {**exes, "/talker": "/bin/true"},
+                      "http://127.0.0.1:1/", str(tmp_path), RunOptions())
     assert [s.log_name for s in specs] == ["rosout-1", "talker-2"]
     assert specs[0].respawn and f"__log:={tmp_path}/rosout-1.log" in specs[0].argv
+
+
+def test_required_flag_leaves_rosout_respawning_instead_of_ending_the_launch(tmp_path):
+    talker = Node("demo", "talker", "talker")
+    specs = run_specs([ROSOUT], [talker], {"/rosout": "/bin/true", "/talker": "/bin/true"},
+                      "http://127.0.0.1:1/", str(tmp_path), RunOptions(all_required=True))
+    assert [(s.name, s.required, s.respawn) for s in specs] == [
+        ("/rosout", False, True), ("/talker", True, False)]
 
 
 def test_no_rosout_option_reaches_the_run_options():

@@ -17,7 +17,7 @@ import time
 import urllib.parse
 import uuid
 import xmlrpc.client
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Mapping
 
 import click
@@ -238,6 +238,15 @@ def build_specs(nodes: list[Node], executables: Mapping[str, str], master_uri: s
     return specs
 
 
+def run_specs(core: list[Node], nodes: list[Node], executables: Mapping[str, str],
+              master_uri: str, run_dir: str, options: RunOptions) -> list[ProcessSpec]:
+    """The specs of a run: roscore's nodes first (so they count from 1, as with roslaunch),
+    then the plan's. ``--required`` is about the plan's nodes: a core node respawns rather
+    than ending the launch."""
+    specs = build_specs(core + nodes, executables, master_uri, run_dir, options)
+    return [replace(spec, required=False) for spec in specs[:len(core)]] + specs[len(core):]
+
+
 @dataclass
 class MasterConnection:
     uri: str
@@ -412,8 +421,8 @@ def run_plan(plan: LaunchPlan, options: Mapping[str, Any]) -> int:
         core = core_nodes(nodes, master.handle is not None, enabled=not opts.no_rosout)
         core_exes = resolve_core_executables(core, echo)
         core = [node for node in core if node.full_name in core_exes]
-        specs = build_specs(core + nodes, {**executables, **core_exes}, master.uri, run_dir,
-                            opts)
+        specs = run_specs(core, nodes, {**executables, **core_exes}, master.uri, run_dir,
+                          opts)
         screen = Screen()
         if not opts.disable_title and plan.files_loaded:
             _set_title(" ".join(plan.files_loaded[:1]) + f" {master.uri}")
