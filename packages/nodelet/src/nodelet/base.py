@@ -19,9 +19,9 @@ _MISSING = object()
 
 
 def from_other_process(msg: Any, own_node: str) -> bool:
-    """False for a TCPROS message this very process published: the local bus delivered it
-    already. (orchestra.node does not connect a process to itself today; this keeps a
-    message from arriving twice should that ever change.)"""
+    """False for a TCPROS message this very process published (orchestra.node, like rospy,
+    delivers a node's own publications to its subscribers): the local bus delivered it
+    already, and a nodelet must see each message once."""
     header = getattr(msg, "_connection_header", None) or {}
     return header.get("callerid") != own_node
 

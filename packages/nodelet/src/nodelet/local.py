@@ -3,8 +3,9 @@
 Nodelets exist so that nodes sharing a process pass messages without the network. Here a
 nodelet's publisher also hands each message straight to the subscriptions of other
 nodelets in the same process on the same (resolved) topic, while TCPROS still serves every
-subscriber outside the process. ``orchestra.node`` never connects a process to itself, so a
-message reaches an in-process subscriber exactly once, through this bus.
+subscriber outside the process. ``orchestra.node`` also hands a process its own publications
+(as rospy does); a nodelet's subscription drops those TCPROS copies (``base.from_other_process``)
+so a message reaches an in-process nodelet exactly once, through this bus.
 
 Delivery is asynchronous, one worker thread per local subscription with a ``queue_size``
 bound (oldest dropped), like a subscriber's receive thread: a slow callback never blocks the
