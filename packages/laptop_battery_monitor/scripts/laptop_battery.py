@@ -56,11 +56,5 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    from orchestra.node import ROSException, ROSInterruptException
-    try:
-        sys.exit(main())
-    except ROSInterruptException:
-        sys.exit(0)
-    except ROSException as exc:  # e.g. no master to talk to: one line, not a traceback
-        sys.stderr.write(f"{os.path.basename(sys.argv[0])}: {exc}\n")
-        sys.exit(1)
+    from orchestra.node.entry import run_main
+    run_main(main)
