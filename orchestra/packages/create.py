@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import jinja2
 
 from orchestra.errors import Location, OrchestraError
+from orchestra.packages.manifest import Person
 
 TEMPLATES = os.path.join(os.path.dirname(os.path.abspath(__file__)), "templates")
 
@@ -53,12 +54,6 @@ class PackageRequest:
     rosdistro: str | None = None
     meta: bool = False
     python_node: str | None = None
-
-
-@dataclass(frozen=True)
-class Person:
-    name: str
-    email: str | None = None
 
 
 @dataclass(frozen=True)
