@@ -61,6 +61,13 @@ def test_dump_params_prints_yaml_without_roscore_params(ws):
 
 
 @pytest.mark.timeout(120)
+def test_dump_params_ends_with_an_empty_line_like_roslaunch(ws):
+    # roslaunch print()s the YAML document, which already ends in a newline
+    proc = orchestra(ws, "demo", "main.launch", "robot:=x", "--dump-params")
+    assert proc.stdout.endswith("\n\n") and not proc.stdout.endswith("\n\n\n")
+
+
+@pytest.mark.timeout(120)
 def test_files_find_node_and_ros_args(ws):
     files = orchestra(ws, "demo", "main.launch", "robot:=x", "--files")
     assert [os.path.basename(f) for f in files.stdout.split()] == ["main.launch", "inc.launch"]

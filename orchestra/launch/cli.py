@@ -167,7 +167,9 @@ def launch(words: tuple[str, ...], dump_plan: bool, dump_params: bool, nodes: bo
         import yaml
         from orchestra.launch.interpreter import Binary
         yaml.SafeDumper.add_representer(Binary, yaml.SafeDumper.represent_binary)
-        click.echo(yaml.safe_dump(dict(plan.params), default_flow_style=False), nl=False)
+        # roslaunch prints the YAML document (which ends in a newline) with print(), so its
+        # output ends in an empty line; scripts diff the two, so match it byte for byte
+        click.echo(yaml.safe_dump(dict(plan.params), default_flow_style=False))
     elif nodes:
         names = [n.full_name for n in (*plan.nodes, *plan.tests) if n.name]
         if names:
