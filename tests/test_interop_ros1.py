@@ -1,0 +1,339 @@
+"""Wire compatibility with REAL ROS 1: Debian's rospy, rosmaster and the ros* tools.
+
+Every test puts real ROS 1 (run by ``/usr/bin/python3``, not orchestra's interpreter) on one
+side and orchestra on the other: rospy nodes against orchestra's master, rospy nodes talking
+TCPROS with orchestra nodes, the real command-line tools against orchestra, orchestra's tools
+against a real ``rosmaster``, and real ``roslaunch`` resolving orchestra's launch files.
+The node program on both sides is the same script (``ros1_nodes/peer.py``), so a failure one
+way only is orchestra's. Masters are on ephemeral ports; every process is killed by a
+finalizer. Skipped as a whole when Debian's ROS 1 is not installed.
+"""
+from __future__ import annotations
+
+import json
+import os
+import signal
+import socket
+import subprocess
+import sys
+import textwrap
+import time
+import xmlrpc.client
+from pathlib import Path
+
+import pytest
+import yaml
+
+sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
+from harness import NodeProcess, wait_for  # noqa: E402
+
+from orchestra.master import start_master  # noqa: E402
+
+ROS_PYTHON = "/usr/bin/python3"
+HERE = Path(__file__).resolve().parent
+PEER = HERE / "ros1_nodes" / "peer.py"
+REPO = HERE.parent
+
+
+def _real_ros_missing() -> str | None:
+    if not os.access(ROS_PYTHON, os.X_OK):
+        return f"{ROS_PYTHON} is not installed"
+    probe = subprocess.run([ROS_PYTHON, "-c", "import rospy, rosmaster"], capture_output=True,
+                           text=True, env=_ros_env({}))
+    if probe.returncode != 0:
+        return ("Debian's ROS 1 (python3-rospy, python3-rosmaster) is not installed for "
+                f"{ROS_PYTHON}: {probe.stderr.strip().splitlines()[-1:]}")
+    return None
+
+
+def _ros_env(extra: dict[str, str]) -> dict[str, str]:
+    """An environment for a real-ROS process: nothing of orchestra's interpreter leaks in."""
+    env = {k: v for k, v in os.environ.items()
+           if not k.startswith(("PYTHON", "ROS_", "VIRTUAL_ENV", "PYENV"))}
+    env["PYTHONUNBUFFERED"] = "1"
+    env.update(extra)
+    return env
+
+
+_MISSING = _real_ros_missing()
+pytestmark = [pytest.mark.skipif(_MISSING is not None, reason=_MISSING or ""),
+              pytest.mark.timeout(60)]
+
+
+def free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+class Side:
+    """Processes of both kinds against one master; ``close()`` kills what is left."""
+
+    def __init__(self, master_uri: str, ros_home: Path, package_path: str = ""):
+        self.master_uri = master_uri
+        common = {"ROS_MASTER_URI": master_uri, "ROS_HOME": str(ros_home),
+                  "ROS_PACKAGE_PATH": package_path}
+        self.ros_env = _ros_env(common)
+        self.orch_env = dict(os.environ, PYTHONUNBUFFERED="1", **common)
+        self.orch_env.pop("ROS_NAMESPACE", None)
+        self.procs: list[NodeProcess] = []
+
+    def rospy(self, *args: str, env: dict[str, str] | None = None) -> NodeProcess:
+        """``peer.py`` as a real rospy node."""
+        return self._start([ROS_PYTHON, str(PEER), *args], dict(self.ros_env, **(env or {})))
+
+    def orch(self, *args: str, env: dict[str, str] | None = None) -> NodeProcess:
+        """``peer.py`` as an orchestra.node node."""
+        return self._start([sys.executable, str(PEER), "--orchestra", *args],
+                           dict(self.orch_env, **(env or {})))
+
+    def tool(self, *argv: str, timeout: float = 20) -> subprocess.CompletedProcess:
+        """A real ROS 1 command-line tool (rostopic, rosparam, ...)."""
+        return subprocess.run([ROS_PYTHON, f"/usr/bin/{argv[0]}", *argv[1:]],
+                              env=self.ros_env, capture_output=True, text=True, timeout=timeout)
+
+    def orchestra(self, *args: str, timeout: float = 20) -> subprocess.CompletedProcess:
+        return subprocess.run([sys.executable, "-m", "orchestra", *args], env=self.orch_env,
+                              capture_output=True, text=True, timeout=timeout)
+
+    def background_tool(self, *argv: str) -> NodeProcess:
+        return self._start([ROS_PYTHON, f"/usr/bin/{argv[0]}", *argv[1:]], self.ros_env)
+
+    def _start(self, argv: list[str], env: dict[str, str]) -> NodeProcess:
+        proc = NodeProcess(argv, env)
+        self.procs.append(proc)
+        return proc
+
+    def master(self) -> xmlrpc.client.ServerProxy:
+        return xmlrpc.client.ServerProxy(self.master_uri)
+
+    def close(self) -> None:
+        for proc in self.procs:
+            proc.signal(signal.SIGINT)
+        deadline = time.monotonic() + 3
+        for proc in self.procs:
+            try:
+                proc.proc.wait(max(0.1, deadline - time.monotonic()))
+            except subprocess.TimeoutExpired:
+                proc.kill()
+
+
+@pytest.fixture
+def master():
+    handle = start_master(host="127.0.0.1", port=0)
+    yield handle
+    handle.shutdown()
+
+
+@pytest.fixture
+def side(master, tmp_path):
+    """orchestra's master with room for real rospy and orchestra nodes."""
+    group = Side(master.uri, tmp_path / "ros_home")
+    yield group
+    group.close()
+
+
+@pytest.fixture
+def real_master(tmp_path):
+    """A real ``rosmaster --core`` on a free port."""
+    port = free_port()
+    uri = f"http://127.0.0.1:{port}/"
+    proc = subprocess.Popen([ROS_PYTHON, "/usr/bin/rosmaster", "--core", "-p", str(port)],
+                            env=_ros_env({"ROS_HOME": str(tmp_path / "ros_home"),
+                                          "ROS_MASTER_URI": uri}),
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    proxy = xmlrpc.client.ServerProxy(uri)
+
+    def up():
+        try:
+            return proxy.getPid("/test")[0] == 1
+        except OSError:
+            return False
+    try:
+        wait_for(up, timeout=15)
+        yield uri
+    finally:
+        proc.terminate()
+        try:
+            proc.wait(5)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+
+
+@pytest.fixture
+def real_side(real_master, tmp_path):
+    """A real rosmaster with room for real rospy and orchestra nodes."""
+    group = Side(real_master, tmp_path / "ros_home")
+    yield group
+    group.close()
+
+
+def messages(proc: NodeProcess, count: int, timeout: float = 10.0) -> list[dict]:
+    return [proc.expect(lambda d: "msg" in d, timeout) for _ in range(count)]
+
+
+# --- 1. a real rospy node against orchestra's master ---------------------------------------
+
+def test_rospy_node_registers_and_lookup_node_returns_its_slave_api(side):
+    talker = side.rospy("--name", "talker", "pub", "chatter", "std_msgs/String", "data: hi")
+    talker.ready()
+    code, _, uri = side.master().lookupNode("/probe", "/talker")
+    assert code == 1
+    assert xmlrpc.client.ServerProxy(uri).getPid("/probe")[2] == talker.proc.pid
+    _, _, state = side.master().getSystemState("/probe")
+    assert ["/chatter", ["/talker"]] in state[0]
+    _, _, topics = side.master().getTopicTypes("/probe")
+    assert ["/chatter", "std_msgs/String"] in topics
+
+
+def _seed_params(params) -> None:
+    params.set("/interop/ns/talker/gains", {"p": 1.5, "i": [0, 1]})
+    params.set("/interop/ns/relative", "in ns")
+    params.set("/absolute", 42)
+    params.set("/interop/shared", "found upward")
+
+
+def test_rospy_and_orchestra_nodes_see_the_same_private_relative_and_searched_params(
+        side, master):
+    _seed_params(master.params)
+    argv = ("--name", "talker", "params", "_speed:=2.5", "__ns:=/interop/ns")
+    real = side.rospy(*argv).ready()
+    ours_proc = side.orch(*argv[:3], "_speed:=2.5", "__name:=talker2", "__ns:=/interop/ns")
+    ours = ours_proc.ready()
+    assert real["params"] == {
+        "name": "/interop/ns/talker", "namespace": "/interop/ns/",
+        "~speed": 2.5, "~gains": {"p": 1.5, "i": [0, 1]}, "relative": "in ns",
+        "/absolute": 42, "~missing": "<default>", "search": "/interop/shared",
+        "written": {"by": "rospy", "n": [1, 2]}, "has_written": True,
+        "has_after_delete": False,
+        "names": ["/interop/ns/relative", "/interop/ns/talker/gains/i",
+                  "/interop/ns/talker/gains/p", "/interop/ns/talker/speed",
+                  "/interop/shared"]}
+    # the orchestra node (named talker2: a second /interop/ns/talker would evict the first)
+    expected = dict(real["params"], name="/interop/ns/talker2", written={"by": "orchestra",
+                    "n": [1, 2]}, **{"~gains": "<default>"})
+    expected["names"] = sorted(real["params"]["names"] + ["/interop/ns/talker2/speed"])
+    assert ours["params"] == expected
+    assert master.params.get("/interop/ns/talker/speed") == 2.5
+
+
+def test_rospy_subscriber_connects_when_an_orchestra_publisher_starts_later(side):
+    listener = side.rospy("--name", "listener", "sub", "chatter", "std_msgs/String")
+    listener.ready()
+    side.orch("--name", "talker", "pub", "chatter", "std_msgs/String", "data: late $N").ready()
+    got = listener.expect(lambda d: "msg" in d)
+    assert got["msg"]["data"].startswith("late ") and got["callerid"] == "/talker"
+
+
+def test_orchestra_subscriber_connects_when_a_rospy_publisher_starts_later(side):
+    listener = side.orch("--name", "listener", "sub", "chatter", "std_msgs/String")
+    listener.ready()
+    side.rospy("--name", "talker", "pub", "chatter", "std_msgs/String", "data: late").ready()
+    assert listener.expect(lambda d: "msg" in d)["callerid"] == "/talker"
+
+
+def test_rospy_cached_param_follows_orchestra_param_set(side, master):
+    master.params.set("/interop/gain", 1)
+    watcher = side.rospy("--name", "watcher", "watch", "/interop/gain")
+    assert watcher.ready()["value"] == 1
+    result = side.orchestra("param", "set", "/interop/gain", "7")
+    assert result.returncode == 0, result.stderr
+    assert watcher.expect(lambda d: d.get("value") == 7, timeout=5)
+    result = side.orchestra("param", "set", "/interop", "{gain: 8, other: x}")
+    assert result.returncode == 0, result.stderr
+    assert watcher.expect(lambda d: d.get("value") == 8, timeout=5)
+
+
+# --- 2. topics both ways --------------------------------------------------------------------
+
+TOPIC_CASES = {
+    "std_msgs/String": ("data: 'hello $N'", lambda m: m["data"].startswith("hello ")),
+    "geometry_msgs/Twist": ("{linear: {x: 0.5, y: -1.25}, angular: {z: 2.0}}",
+                            lambda m: m == {"linear": {"x": 0.5, "y": -1.25, "z": 0.0},
+                                            "angular": {"x": 0.0, "y": 0.0, "z": 2.0}}),
+    "geometry_msgs/PoseArray": (
+        "{header: {frame_id: map, stamp: {secs: 12, nsecs: 34}}, poses: ["
+        "{position: {x: 1.0}, orientation: {w: 1.0}}, {position: {y: 2.0}, "
+        "orientation: {z: 0.5, w: 0.5}}]}",
+        lambda m: m["header"]["frame_id"] == "map"
+        and m["header"]["stamp"] == {"secs": 12, "nsecs": 34}
+        and len(m["poses"]) == 2 and m["poses"][1]["orientation"]["z"] == 0.5
+        and m["poses"][0]["position"] == {"x": 1.0, "y": 0.0, "z": 0.0}),
+}
+
+
+@pytest.mark.parametrize("direction", ["rospy_to_orchestra", "orchestra_to_rospy"])
+def test_messages_cross_between_rospy_and_orchestra(side, direction):
+    publish, subscribe = ((side.rospy, side.orch) if direction == "rospy_to_orchestra"
+                          else (side.orch, side.rospy))
+    subs = {}
+    for i, type_name in enumerate(TOPIC_CASES):
+        subs[type_name] = subscribe("--name", f"sub{i}", "sub", f"topic{i}", type_name)
+        publish("--name", f"pub{i}", "pub", f"topic{i}", type_name, TOPIC_CASES[type_name][0])
+    for type_name, sub in subs.items():
+        got = messages(sub, 2)
+        assert all(TOPIC_CASES[type_name][1](g["msg"]) for g in got), got
+    # a header's seq is set per publisher, counting up
+    seqs = [g["msg"]["header"]["seq"] for g in messages(subs["geometry_msgs/PoseArray"], 2)]
+    assert seqs[1] == seqs[0] + 1
+
+
+@pytest.mark.parametrize("direction", ["rospy_to_orchestra", "orchestra_to_rospy"])
+def test_latched_message_reaches_a_late_subscriber_across_implementations(side, direction):
+    publish, subscribe = ((side.rospy, side.orch) if direction == "rospy_to_orchestra"
+                          else (side.orch, side.rospy))
+    pub = publish("--name", "latcher", "pub", "/map_name", "std_msgs/String", "data: once",
+                  "--latch", "--count", "1")
+    pub.expect(lambda d: "sent" in d)
+    sub = subscribe("--name", "late", "sub", "/map_name", "std_msgs/String")
+    got = sub.expect(lambda d: "msg" in d)
+    assert got["msg"] == {"data": "once"} and got["latching"] == "1"
+
+
+@pytest.mark.parametrize("direction", ["rospy_to_orchestra", "orchestra_to_rospy"])
+def test_md5_mismatch_is_refused_and_both_nodes_keep_working(side, direction):
+    publish, subscribe = ((side.rospy, side.orch) if direction == "rospy_to_orchestra"
+                          else (side.orch, side.rospy))
+    pub = publish("--name", "talker", "pub", "chatter", "std_msgs/String", "data: text")
+    wrong = subscribe("--name", "wrong", "sub", "chatter", "geometry_msgs/Twist")
+    right = subscribe("--name", "right", "sub", "chatter", "std_msgs/String")
+    pub.ready()
+    wrong.ready()
+    assert right.expect(lambda d: "msg" in d)["msg"] == {"data": "text"}
+    time.sleep(0.5)
+    assert not [d for d in wrong.seen + _drain(wrong) if "msg" in d]
+    assert pub.proc.poll() is None and wrong.proc.poll() is None
+    # the refused subscriber's node still answers its slave API
+    _, _, uri = side.master().lookupNode("/probe", "/wrong")
+    assert xmlrpc.client.ServerProxy(uri).getPid("/probe")[0] == 1
+
+
+def _drain(proc: NodeProcess) -> list[dict]:
+    items = []
+    while not proc.lines.empty():
+        items.append(proc.lines.get())
+    return items
+
+
+# --- 3. services both ways ------------------------------------------------------------------
+
+@pytest.mark.parametrize("persistent", [False, True], ids=["plain", "persistent"])
+@pytest.mark.parametrize("direction", ["rospy_serves", "orchestra_serves"])
+def test_service_calls_cross_between_rospy_and_orchestra(side, direction, persistent):
+    serve, call = ((side.rospy, side.orch) if direction == "rospy_serves"
+                   else (side.orch, side.rospy))
+    server_impl = "rospy" if direction == "rospy_serves" else "orchestra"
+    serve("--name", "server", "serve", "set_bool", "std_srvs/SetBool")
+    serve("--name", "emptyserver", "serve", "empty", "std_srvs/Empty")
+    extra = ("--persistent",) if persistent else ()
+    caller = call("--name", "caller", "call", "/set_bool", "std_srvs/SetBool",
+                  "{data: true}", "{data: false}", "{data: true}", *extra)
+    empty = call("--name", "ecaller", "call", "/empty", "std_srvs/Empty", "{}", "{}")
+    results = caller.expect(lambda d: "results" in d, timeout=15)["results"]
+    assert results[0] == {"ok": {"success": True, "message": f"{server_impl} call 1"}}
+    # the handler's exception reaches the caller as ServiceException with its text
+    assert "refused by " + server_impl in results[1]["error"]
+    # the server survived the exception (and, persistent, kept the same connection)
+    assert results[2] == {"ok": {"success": True, "message": f"{server_impl} call 3"}}
+    assert empty.expect(lambda d: "results" in d, timeout=15)["results"] == [{"ok": {}}] * 2
