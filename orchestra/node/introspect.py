@@ -5,6 +5,7 @@ the topic types added; the CLI and the graph drawer only format it.
 """
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 
 from orchestra.errors import OrchestraError
@@ -85,12 +86,40 @@ def node_bus_info(node_uri: str) -> tuple[int | None, list]:
     return pid, info
 
 
-def kill_node(master_uri: str, node: str) -> None:
+def kill_node(master_uri: str, node: str, settle: float = 2.0) -> None:
+    """Ask ``node`` to shut down through its slave API.
+
+    rospy tears its XML-RPC server down while still handling ``shutdown``, so the reply is
+    often lost (the connection drops, and xmlrpc.client's one retry is refused). rosnode
+    therefore assumes success whatever happens; we check instead: a node that answered
+    before the request and stops answering within ``settle`` seconds has been killed.
+    """
     uri = lookup_node(master_uri, node)
     try:
-        call(uri, "shutdown", CALLER, "user request", timeout=5.0)
+        call(uri, "getPid", CALLER, timeout=2.0)
     except MasterError as exc:
-        raise GraphError(f"node [{node}] did not accept the shutdown request: {exc}") from None
+        raise GraphError(f"node [{node}] does not answer at {uri}: {exc}") from None
+    try:
+        call(uri, "shutdown", CALLER, "user request", timeout=5.0)
+        return
+    except MasterError as exc:
+        failure = exc
+    if failure.code is None and _stops_answering(uri, settle):
+        return
+    raise GraphError(f"node [{node}] did not accept the shutdown request: {failure}")
+
+
+def _stops_answering(uri: str, within: float) -> bool:
+    deadline = time.monotonic() + within
+    while True:
+        try:
+            call(uri, "getPid", CALLER, timeout=1.0)
+        except MasterError as exc:
+            if exc.code is None:
+                return True
+        if time.monotonic() >= deadline:
+            return False
+        time.sleep(0.05)
 
 
 def service_uri(master_uri: str, service: str) -> str:

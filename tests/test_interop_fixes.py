@@ -1,0 +1,128 @@
+"""Fixes found by the real-ROS interop tests (tests/test_interop_ros1.py), pinned without ROS.
+
+Each test reproduces what a real ROS 1 peer does on the wire with a small stand-in, so the
+behaviour stays pinned on machines where Debian's ROS 1 is not installed.
+"""
+from __future__ import annotations
+
+import socket
+import threading
+import xmlrpc.client
+from xmlrpc.server import SimpleXMLRPCRequestHandler, SimpleXMLRPCServer
+
+import pytest
+
+from orchestra.master import start_master
+from orchestra.node import introspect
+
+pytestmark = pytest.mark.timeout(30)
+
+
+class _RospyLikeSlave:
+    """A slave API that, like rospy, closes its server while handling ``shutdown``.
+
+    ``reply`` decides what ``shutdown`` does: "drop" (rospy: no reply, server gone),
+    "refuse" (answers -1 and keeps serving), "drop_but_live" (drops the connection, keeps
+    serving).
+    """
+
+    def __init__(self, reply: str):
+        self.reply = reply
+        self.done = False
+        owner = self
+
+        class Handler(SimpleXMLRPCRequestHandler):
+            def do_POST(self):  # noqa: N802 (http.server's name)
+                body = self.rfile.read(int(self.headers["content-length"]))
+                method = xmlrpc.client.loads(body)[1]
+                if method == "shutdown" and owner.reply != "refuse":
+                    self.close_connection = True
+                    if owner.reply == "drop":
+                        owner.done = True
+                        self.server.socket.close()
+                    return
+                if method == "shutdown":
+                    data = xmlrpc.client.dumps(([-1, "not now", 0],), methodresponse=True)
+                else:
+                    data = xmlrpc.client.dumps(([1, "", 4242],), methodresponse=True)
+                self.send_response(200)
+                self.send_header("Content-Type", "text/xml")
+                self.send_header("Content-Length", str(len(data)))
+                self.end_headers()
+                self.wfile.write(data.encode())
+
+            def log_message(self, *args):
+                pass
+
+        self.server = SimpleXMLRPCServer(("127.0.0.1", 0), Handler, logRequests=False)
+        self.server.timeout = 0.05
+        self.uri = f"http://127.0.0.1:{self.server.server_address[1]}/"
+        self.thread = threading.Thread(target=self._serve, daemon=True)
+        self.thread.start()
+
+    def _serve(self) -> None:
+        while not self.done:
+            try:
+                self.server.handle_request()
+            except (OSError, ValueError):
+                return
+
+    def close(self) -> None:
+        self.done = True
+        try:
+            self.server.socket.close()
+        except OSError:
+            pass
+        self.thread.join(2)
+
+
+@pytest.fixture
+def master():
+    handle = start_master(host="127.0.0.1", port=0)
+    yield handle
+    handle.shutdown()
+
+
+def _register(master, slave: _RospyLikeSlave) -> None:
+    proxy = xmlrpc.client.ServerProxy(master.uri)
+    assert proxy.registerPublisher("/victim", "/t", "std_msgs/String", slave.uri)[0] == 1
+
+
+def test_kill_counts_a_node_that_drops_the_reply_and_goes_silent_as_killed(master):
+    slave = _RospyLikeSlave("drop")
+    try:
+        _register(master, slave)
+        introspect.kill_node(master.uri, "/victim")
+        assert slave.done
+    finally:
+        slave.close()
+
+
+def test_kill_fails_when_the_node_refuses_the_shutdown(master):
+    slave = _RospyLikeSlave("refuse")
+    try:
+        _register(master, slave)
+        with pytest.raises(introspect.GraphError, match="did not accept"):
+            introspect.kill_node(master.uri, "/victim")
+    finally:
+        slave.close()
+
+
+def test_kill_fails_when_the_connection_drops_but_the_node_keeps_answering(master):
+    slave = _RospyLikeSlave("drop_but_live")
+    try:
+        _register(master, slave)
+        with pytest.raises(introspect.GraphError, match="did not accept"):
+            introspect.kill_node(master.uri, "/victim", settle=0.3)
+    finally:
+        slave.close()
+
+
+def test_kill_of_a_node_that_no_longer_answers_names_it(master):
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        dead_uri = f"http://127.0.0.1:{sock.getsockname()[1]}/"
+    proxy = xmlrpc.client.ServerProxy(master.uri)
+    proxy.registerPublisher("/ghost", "/t", "std_msgs/String", dead_uri)
+    with pytest.raises(introspect.GraphError, match=r"node \[/ghost\] does not answer"):
+        introspect.kill_node(master.uri, "/ghost")
