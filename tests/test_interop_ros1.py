@@ -337,3 +337,132 @@ def test_service_calls_cross_between_rospy_and_orchestra(side, direction, persis
     # the server survived the exception (and, persistent, kept the same connection)
     assert results[2] == {"ok": {"success": True, "message": f"{server_impl} call 3"}}
     assert empty.expect(lambda d: "results" in d, timeout=15)["results"] == [{"ok": {}}] * 2
+
+
+# --- 4. the tools crossed -------------------------------------------------------------------
+
+def test_real_rostopic_lists_inspects_echoes_and_publishes_with_orchestra_nodes(side):
+    side.orch("--name", "talker", "pub", "chatter", "std_msgs/String", "data: hello").ready()
+    listener = side.orch("--name", "listener", "sub", "chatter", "std_msgs/String")
+    cmd = side.orch("--name", "driver", "sub", "cmd", "geometry_msgs/Twist")
+    listener.ready()
+    cmd.ready()
+    pub = side.background_tool("rostopic", "pub", "-r", "10", "/cmd", "geometry_msgs/Twist",
+                               "{linear: {x: 0.25}}")
+    listed = side.tool("rostopic", "list")
+    assert listed.returncode == 0, listed.stderr
+    assert {"/chatter", "/cmd"} <= set(listed.stdout.split())
+    info = side.tool("rostopic", "info", "/chatter")
+    assert info.returncode == 0, info.stderr
+    assert "Type: std_msgs/String" in info.stdout
+    pubs, subs = info.stdout.split("Subscribers:")
+    assert " * /talker (http://" in pubs and " * /listener (http://" in subs
+    echo = side.tool("rostopic", "echo", "-n", "2", "/chatter")
+    assert echo.returncode == 0, echo.stderr
+    assert echo.stdout == 'data: "hello"\n---\ndata: "hello"\n---\n'
+    typ = side.tool("rostopic", "type", "/chatter")
+    assert typ.stdout == "std_msgs/String\n"
+    got = cmd.expect(lambda d: "msg" in d and d["callerid"].startswith("/rostopic_"))
+    assert got["msg"]["linear"]["x"] == 0.25
+    pub.signal(signal.SIGINT)
+
+
+def test_real_rosparam_sets_gets_dumps_and_loads_on_orchestra_master(side, master, tmp_path):
+    master.params.set("/robot/limits", {"speed": 1.5, "names": ["a", "b"]})
+    assert side.tool("rosparam", "set", "/robot/mode", "fast").returncode == 0
+    assert master.params.get("/robot/mode") == "fast"
+    got = side.tool("rosparam", "get", "/robot/limits/speed")
+    assert (got.returncode, got.stdout) == (0, "1.5\n")
+    dump = tmp_path / "robot.yaml"
+    assert side.tool("rosparam", "dump", str(dump), "/robot").returncode == 0
+    assert yaml.safe_load(dump.read_text()) == {"limits": {"speed": 1.5, "names": ["a", "b"]},
+                                                "mode": "fast"}
+    assert side.tool("rosparam", "load", str(dump), "/copy").returncode == 0
+    assert master.params.get("/copy") == master.params.get("/robot")
+    listed = side.tool("rosparam", "list", "/copy")
+    assert listed.stdout.split() == ["/copy/limits/names", "/copy/limits/speed", "/copy/mode"]
+    assert side.tool("rosparam", "delete", "/copy/mode").returncode == 0
+    assert not master.params.has("/copy/mode")
+    # and what orchestra's rosparam prints for the same value, real rosparam prints too
+    ours = side.orchestra("param", "get", "/robot")
+    assert ours.stdout == side.tool("rosparam", "get", "/robot").stdout
+
+
+def test_real_rosservice_lists_and_calls_orchestra_services(side):
+    side.orch("--name", "server", "serve", "set_bool", "std_srvs/SetBool").ready()
+    listed = side.tool("rosservice", "list")
+    assert listed.returncode == 0, listed.stderr
+    assert "/set_bool" in listed.stdout.split()
+    assert "/server/get_loggers" not in listed.stdout  # orchestra offers no logger services
+    typ = side.tool("rosservice", "type", "/set_bool")
+    assert typ.stdout == "std_srvs/SetBool\n"
+    call = side.tool("rosservice", "call", "/set_bool", "data: true")
+    assert (call.returncode, call.stdout) == (0, 'success: True\nmessage: "orchestra call 1"\n')
+    failed = side.tool("rosservice", "call", "/set_bool", "data: false")
+    assert failed.returncode != 0
+    assert "refused by orchestra" in failed.stderr + failed.stdout
+
+
+def test_real_rosnode_lists_inspects_and_kills_orchestra_nodes(side):
+    talker = side.orch("--name", "talker", "pub", "chatter", "std_msgs/String", "data: x")
+    side.orch("--name", "listener", "sub", "chatter", "std_msgs/String").expect(
+        lambda d: "msg" in d)
+    talker.ready()
+    listed = side.tool("rosnode", "list")
+    assert {"/talker", "/listener"} <= set(listed.stdout.split()), listed
+    info = side.tool("rosnode", "info", "/talker")
+    assert info.returncode == 0, info.stderr
+    assert "Publications: \n * /chatter [std_msgs/String]" in info.stdout
+    assert f"Pid: {talker.proc.pid}" in info.stdout
+    assert "topic: /chatter\n    * to: /listener\n    * direction: outbound" in info.stdout
+    kill = side.tool("rosnode", "kill", "/talker")
+    assert kill.returncode == 0, kill.stderr
+    assert talker.wait(10) == 0
+    assert "/talker" not in side.tool("rosnode", "list").stdout.split()
+
+
+def test_orchestra_tools_work_against_a_real_rosmaster_and_rospy_nodes(real_side, tmp_path):
+    side = real_side
+    talker = side.rospy("--name", "talker", "pub", "chatter", "geometry_msgs/Twist",
+                        "{linear: {x: 1.5}}")
+    server = side.rospy("--name", "server", "serve", "set_bool", "std_srvs/SetBool")
+    listener = side.rospy("--name", "listener", "sub", "cmd", "std_msgs/String")
+    for proc in (talker, server, listener):
+        proc.ready()
+    topics = side.orchestra("topic", "list")
+    assert topics.returncode == 0, topics.stderr
+    assert {"/chatter", "/cmd", "/rosout"} <= set(topics.stdout.split())
+    info = side.orchestra("topic", "info", "/chatter")
+    assert "Type: geometry_msgs/Twist" in info.stdout and " * /talker (http://" in info.stdout
+    echo = side.orchestra("topic", "echo", "/chatter/linear/x", "-n", "1")
+    assert (echo.returncode, echo.stdout) == (0, "1.5\n---\n"), echo.stderr
+    pub = side.orchestra("topic", "pub", "-1", "/cmd", "std_msgs/String", "data: from us")
+    assert pub.returncode == 0, pub.stderr
+    assert listener.expect(lambda d: "msg" in d)["msg"] == {"data": "from us"}
+
+    assert side.orchestra("param", "set", "/robot/gains", "{p: 2, d: [1, 2]}").returncode == 0
+    got = side.tool("rosparam", "get", "/robot/gains/p")
+    assert got.stdout == "2\n"
+    assert side.orchestra("param", "get", "/robot/gains").stdout == \
+        side.tool("rosparam", "get", "/robot/gains").stdout
+    dump = tmp_path / "dump.yaml"
+    assert side.orchestra("param", "dump", str(dump), "/robot").returncode == 0
+    assert yaml.safe_load(dump.read_text()) == {"gains": {"p": 2, "d": [1, 2]}}
+
+    services = side.orchestra("service", "list")
+    assert "/set_bool" in services.stdout.split(), services.stderr
+    call = side.orchestra("service", "call", "/set_bool", "data: true")
+    assert (call.returncode, call.stdout) == (0, 'success: True\nmessage: "rospy call 1"\n')
+    refused = side.orchestra("service", "call", "/set_bool", "data: false")
+    assert refused.returncode == 1 and "refused by rospy" in refused.stderr
+
+    nodes = side.orchestra("node", "list")
+    assert {"/talker", "/server", "/listener"} <= set(nodes.stdout.split())
+    node_info = side.orchestra("node", "info", "/talker")
+    assert node_info.returncode == 0, node_info.stderr
+    assert f"Pid: {talker.proc.pid}" in node_info.stdout
+    assert " * /chatter [geometry_msgs/Twist]" in node_info.stdout
+    kill = side.orchestra("node", "kill", "/talker")
+    assert kill.returncode == 0, kill.stderr
+    talker.wait(10)
+    assert "/talker" not in side.orchestra("node", "list").stdout.split()
