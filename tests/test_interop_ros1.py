@@ -466,3 +466,105 @@ def test_orchestra_tools_work_against_a_real_rosmaster_and_rospy_nodes(real_side
     assert kill.returncode == 0, kill.stderr
     talker.wait(10)
     assert "/talker" not in side.orchestra("node", "list").stdout.split()
+
+
+# --- 5. orchestra launch running a real rospy node ------------------------------------------
+
+ROS1_PACKAGES = str(HERE / "ros1_nodes")
+REPORT_LAUNCH = HERE / "ros1_nodes" / "interop_pkg" / "launch" / "report.launch"
+
+
+def _wait_for_file(path: Path, proc: subprocess.Popen, log: Path, timeout: float = 20) -> dict:
+    def ready():
+        if proc.poll() is not None:
+            raise AssertionError(f"{proc.args[:3]} exited {proc.returncode}: "
+                                 f"{log.read_text()[-2000:]}")
+        return path.exists()
+    try:
+        wait_for(ready, timeout=timeout)
+    except AssertionError as exc:
+        raise AssertionError(f"{exc}\n{log.read_text()[-2000:]}") from None
+    return json.loads(path.read_text())
+
+
+def _stop(proc: subprocess.Popen, timeout: float = 10) -> int:
+    if proc.poll() is None:
+        proc.send_signal(signal.SIGINT)
+    try:
+        return proc.wait(timeout)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        return proc.wait()
+
+
+def test_rospy_node_sees_the_same_names_remaps_and_params_under_orchestra_and_roslaunch(
+        real_master, tmp_path):
+    ros_out, orch_out = tmp_path / "roslaunch.json", tmp_path / "orchestra.json"
+    ros_log, orch_log = tmp_path / "roslaunch.log", tmp_path / "orchestra.log"
+    home = {"ROS_HOME": str(tmp_path / "ros_home"), "ROS_PACKAGE_PATH": ROS1_PACKAGES}
+    orch_port = free_port()
+    with open(ros_log, "w") as rlog, open(orch_log, "w") as olog:
+        roslaunch = subprocess.Popen(
+            [ROS_PYTHON, "/usr/bin/roslaunch", str(REPORT_LAUNCH), f"out:={ros_out}"],
+            env=_ros_env(dict(home, ROS_MASTER_URI=real_master)),
+            stdout=rlog, stderr=subprocess.STDOUT)
+        ours = subprocess.Popen(
+            [sys.executable, "-m", "orchestra", "launch", "-p", str(orch_port), "--no-status",
+             str(REPORT_LAUNCH), f"out:={orch_out}"],
+            env=dict(os.environ, ROS_MASTER_URI=f"http://127.0.0.1:{orch_port}/", **home),
+            stdout=olog, stderr=subprocess.STDOUT)
+    try:
+        expected = _wait_for_file(ros_out, roslaunch, ros_log)
+        got = _wait_for_file(orch_out, ours, orch_log)
+    finally:
+        ros_code, orch_code = _stop(roslaunch), _stop(ours)
+    assert expected == {
+        "name": "/robot/reporter", "namespace": "/robot/", "ROS_NAMESPACE": "/robot",
+        "chatter": "/robot/speech", "published": ["/robot/speech", "/rosout"],
+        "private": {"rate": 5.5, "label": "007", "config": {"a": 1, "b": ["x", "y"]}},
+        "global": "g", "argv": ["extra", "word"]}
+    assert got == expected
+    assert (ros_code, orch_code) == (0, 0), orch_log.read_text()[-2000:]
+
+
+def test_orchestra_launch_waits_for_an_external_rosmaster_and_uploads_params(tmp_path):
+    port = free_port()
+    uri = f"http://127.0.0.1:{port}/"
+    out, log = tmp_path / "report.json", tmp_path / "orchestra.log"
+    env = dict(os.environ, ROS_MASTER_URI=uri, ROS_HOME=str(tmp_path / "ros_home"),
+               ROS_PACKAGE_PATH=ROS1_PACKAGES)
+    with open(log, "w") as olog:
+        ours = subprocess.Popen([sys.executable, "-m", "orchestra", "launch", "--wait",
+                                 "--no-status", str(REPORT_LAUNCH), f"out:={out}"],
+                                env=env, stdout=olog, stderr=subprocess.STDOUT)
+    rosmaster = None
+    try:
+        wait_for(lambda: "waiting for the master" in log.read_text(), timeout=15)
+        assert ours.poll() is None
+        rosmaster = subprocess.Popen(
+            [ROS_PYTHON, "/usr/bin/rosmaster", "--core", "-p", str(port)],
+            env=_ros_env({"ROS_MASTER_URI": uri, "ROS_HOME": str(tmp_path / "ros_home")}),
+            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        report = _wait_for_file(out, ours, log)
+        assert report["private"] == {"rate": 5.5, "label": "007",
+                                     "config": {"a": 1, "b": ["x", "y"]}}
+        real = xmlrpc.client.ServerProxy(uri)
+        assert real.getParam("/probe", "/robot/reporter/rate")[2] == 5.5
+        assert real.getParam("/probe", "/interop/global")[2] == "g"
+        assert real.getParam("/probe", "/run_id")[0] == 1
+        code, _, state = real.getSystemState("/probe")
+        assert ["/robot/speech", ["/robot/reporter"]] in state[0]
+        # the run leaves the external master running and its node unregistered
+        assert _stop(ours) == 0, log.read_text()[-2000:]
+        assert real.getPid("/probe")[0] == 1
+        state = real.getSystemState("/probe")[2]
+        assert not [t for t, nodes in state[0] if "/robot/reporter" in nodes]
+    finally:
+        _stop(ours)
+        if rosmaster is not None:
+            rosmaster.terminate()
+            try:
+                rosmaster.wait(5)
+            except subprocess.TimeoutExpired:
+                rosmaster.kill()
+                rosmaster.wait()
