@@ -312,9 +312,9 @@ def print_table(rows: list) -> None:
     if not rows:
         return
     print()
-    print(f"{'what':<58} {'orchestra':>11} {'roslaunch':>11} {'ratio':>7}  target")
+    print(f"{'what':<62} {'orchestra':>11} {'roslaunch':>11} {'ratio':>7}  target")
     for what, ours, theirs, ratio, target in rows:
-        print(f"{what:<58} {ours:>11} {theirs:>11} {ratio:>6.1f}x  {target}")
+        print(f"{what:<62} {ours:>11} {theirs:>11} {ratio:>6.1f}x  {target}")
     print("ratio = real roslaunch time / orchestra time (higher: orchestra faster)")
 
 

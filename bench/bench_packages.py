@@ -170,9 +170,10 @@ def bench_ros1(label: str, root: str, repeat: int, results: dict, rows: list) ->
         # finds them), and one unknown $(find) would make roslaunch reject the whole file
         theirs = set(ros1.run_ros1_code("import rospkg\nRESULT = rospkg.RosPack().list()", None,
                                         env=ros1.base_env(ROS_PACKAGE_PATH=root)))
-        if len(theirs) != len(names):
+        if set(names) - theirs:
             print(f"{label}: orchestra finds {len(names)} packages, real rospkg {len(theirs)} "
-                  f"(not in ROS 1: {', '.join(sorted(set(names) - theirs)[:5])} ...)")
+                  f"(ROS 1 has /usr/share too; orchestra-only: "
+                  f"{', '.join(sorted(set(names) - theirs)[:5])} ...)")
         names = [name for name in names if name in theirs]
     work = tempfile.mkdtemp(prefix="orchestra-bench-finds-")
     o_home, r_home = os.path.join(work, "o_home"), os.path.join(work, "r_home")
