@@ -12,11 +12,11 @@ from __future__ import annotations
 
 import json
 import os
+import shlex
 import signal
 import socket
 import subprocess
 import sys
-import textwrap
 import time
 import xmlrpc.client
 from pathlib import Path
@@ -568,3 +568,58 @@ def test_orchestra_launch_waits_for_an_external_rosmaster_and_uploads_params(tmp
             except subprocess.TimeoutExpired:
                 rosmaster.kill()
                 rosmaster.wait()
+
+
+# --- 6. real roslaunch resolving orchestra's bundled demos ----------------------------------
+
+DEMOS = sorted(f"{p.parent.parent.name} {p.name}"
+               for p in (REPO / "packages").glob("*/launch/*.launch"))
+# the URI every node gets; set in both environments so roslaunch's --args prints no
+# ROS_MASTER_URI=... prefix (it prefixes variables that differ from the caller's)
+DUMP_ENV = {"ROS_PACKAGE_PATH": str(REPO / "packages"),
+            "ROS_MASTER_URI": "http://localhost:11311/"}
+
+
+@pytest.fixture(scope="module")
+def roslaunch_dumps(tmp_path_factory) -> dict:
+    """--nodes/--dump-params/--files/--args of every demo, from real roslaunch (one process)."""
+    home = tmp_path_factory.mktemp("ros_home")
+    result = subprocess.run([ROS_PYTHON, str(HERE / "ros1_nodes" / "roslaunch_resolve.py"),
+                             *DEMOS], env=_ros_env(dict(DUMP_ENV, ROS_HOME=str(home))),
+                            capture_output=True, text=True, timeout=50)
+    assert result.returncode == 0, result.stderr
+    return json.loads(result.stdout)
+
+
+def _orchestra_dumps(words: str, nodes: list[str]) -> dict:
+    """The same four answers from ``orchestra launch``, its processes run concurrently."""
+    env = dict(os.environ, **DUMP_ENV)
+    runs = {option: [sys.executable, "-m", "orchestra", "launch", *option.split(),
+                     *words.split()]
+            for option in ["--nodes", "--dump-params", "--files",
+                           *(f"--args {node}" for node in nodes)]}
+    procs = {option: subprocess.Popen(argv, env=env, stdout=subprocess.PIPE,
+                                      stderr=subprocess.PIPE, text=True)
+             for option, argv in runs.items()}
+    outputs = {}
+    for option, proc in procs.items():
+        out, err = proc.communicate(timeout=30)
+        outputs[option] = out if proc.returncode == 0 else {"error": err}
+    return outputs
+
+
+@pytest.mark.timeout(90)
+@pytest.mark.parametrize("demo", DEMOS)
+def test_real_roslaunch_resolves_bundled_demo_to_the_same_nodes_params_and_argv(
+        roslaunch_dumps, demo):
+    real = roslaunch_dumps[demo]
+    assert isinstance(real["nodes"], str), real["nodes"]
+    ours = _orchestra_dumps(demo, real["nodes"].split())
+    assert ours["--nodes"] == real["nodes"]
+    assert yaml.safe_load(ours["--dump-params"]) == yaml.safe_load(real["params"])
+    # roslaunch prints the files read from a set (any order); orchestra in reading order
+    assert sorted(ours["--files"].split()) == sorted(real["files"].split())
+    # roslaunch writes env prefixes as K="v", orchestra shell-quotes only when needed
+    # (K=v): compared as the words a shell makes of them, which is what `| bash` runs
+    for node, argv in real["args"].items():
+        assert shlex.split(ours[f"--args {node}"]) == shlex.split(argv), node
