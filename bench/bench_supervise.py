@@ -1,6 +1,6 @@
 """Process-supervision figures, each with a baseline measured in the same run.
 
-    python bench/bench_supervise.py [--nodes 100] [--kills 30] [--idle 5]
+    python bench/bench_supervise.py [--quick] [--nodes 100] [--kills 30] [--idle 5]
 
 1. cold start: ``orchestra launch`` of N nodes (embedded master) until its status socket
    reports all N RUNNING; baseline: a fresh Python that Popen's the same N processes.
@@ -10,6 +10,13 @@
    on N bare Popen'd processes. Target: < 0.5 s.
 4. supervisor CPU with N idle nodes over a window (orchestra process, embedded master
    included), in % of one core. Target: < 1 %.
+5. against the real ROS 1 roslaunch (Debian's 1.15, /usr/bin/roslaunch), the same launch file
+   of N trivial sleeping ``#!/usr/bin/python3`` nodes, each launcher starting its own master
+   on a free port, both probed the same way (the launcher's descendant processes):
+   start until all N node processes run; SIGINT to the launcher until it and every node are
+   gone; a launch whose nodes ignore SIGINT (default timeouts, then ``--sigint-timeout``);
+   and the processes left running after the launcher is SIGKILLed (orphans, then killed).
+   Skipped with a message when roslaunch is missing.
 """
 from __future__ import annotations
 
@@ -31,6 +38,8 @@ import psutil
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, REPO)
 
+sys.path.insert(0, os.path.join(REPO, "bench"))
+import ros1  # noqa: E402
 from orchestra.supervise.output import Screen  # noqa: E402
 from orchestra.supervise.process import OutputMode, ProcessSpec, RestartPolicy, State  # noqa: E402
 from orchestra.supervise.supervisor import Supervisor  # noqa: E402
@@ -180,18 +189,231 @@ def stop_time(n: int) -> dict[str, float]:
     return {"stop": stop, "stop_baseline": time.perf_counter() - t0}
 
 
+# --- against the real roslaunch ------------------------------------------------------------------
+
+PY_NODE = """#!/usr/bin/python3
+# a trivial node: sleeps until SIGINT (or, when stubborn, ignores SIGINT until SIGTERM)
+import signal, sys, time
+signal.signal(signal.SIGINT, signal.SIG_IGN if "stubborn" in sys.argv[0]
+              else (lambda *_: sys.exit(0)))
+signal.signal(signal.SIGTERM, lambda *_: sys.exit(0))
+while True:
+    time.sleep(1000)
+"""
+
+
+def make_py_workspace(root: str, n: int, stubborn: int = 0) -> str:
+    """Package ``rbench`` with the python nodes ``sleeper`` and ``stubborn``; a launch of
+    ``n`` sleepers plus ``stubborn`` SIGINT-ignoring nodes. Returns the launch file."""
+    pkg = os.path.join(root, "ws", "rbench")
+    os.makedirs(os.path.join(pkg, "scripts"), exist_ok=True)
+    with open(os.path.join(pkg, "package.xml"), "w") as fh:
+        fh.write("<package format='2'><name>rbench</name><version>0.0.0</version>"
+                 "<description>b</description><maintainer email='a@b.c'>a</maintainer>"
+                 "<license>BSD</license></package>")
+    for name in ("sleeper", "stubborn"):
+        path = os.path.join(pkg, "scripts", name)
+        with open(path, "w") as fh:
+            fh.write(PY_NODE)
+        os.chmod(path, 0o755)
+    launch = os.path.join(root, f"py_{n}_{stubborn}.launch")
+    with open(launch, "w") as fh:
+        fh.write("<launch>\n")
+        for i in range(n):
+            fh.write(f'  <node pkg="rbench" type="sleeper" name="s{i:03d}"/>\n')
+        for i in range(stubborn):
+            fh.write(f'  <node pkg="rbench" type="stubborn" name="x{i:02d}"/>\n')
+        fh.write("</launch>\n")
+    return launch
+
+
+def node_procs(launcher: psutil.Process) -> list[psutil.Process]:
+    """The launcher's descendants running one of the bench nodes (not master or rosout)."""
+    found = []
+    try:
+        children = launcher.children(recursive=True)
+    except psutil.NoSuchProcess:
+        return found
+    for child in children:
+        try:
+            if any("rbench/scripts/" in word for word in child.cmdline()[:3]):
+                found.append(child)
+        except (psutil.NoSuchProcess, psutil.AccessDenied, psutil.ZombieProcess):
+            pass
+    return found
+
+
+def alive(procs: list[psutil.Process]) -> list[psutil.Process]:
+    out = []
+    for proc in procs:
+        try:
+            if proc.is_running() and proc.status() != psutil.STATUS_ZOMBIE:
+                out.append(proc)
+        except psutil.NoSuchProcess:
+            pass
+    return out
+
+
+class Launcher:
+    """One ``roslaunch`` or ``orchestra launch`` run of a launch file, on its own port."""
+
+    def __init__(self, kind: str, launch: str, root: str, extra: tuple[str, ...] = ()) -> None:
+        port = free_port()
+        uri = f"http://127.0.0.1:{port}/"
+        self.kind = kind
+        home = os.path.join(root, f"home_{kind}")
+        if kind == "roslaunch":
+            env = ros1.base_env(ROS_PACKAGE_PATH=os.path.join(root, "ws"), ROS_HOME=home,
+                                ROS_MASTER_URI=uri)
+            argv = [ros1.tool("roslaunch"), "-p", str(port), *extra, launch]
+        else:
+            env = dict(os.environ, ROS_PACKAGE_PATH=os.path.join(root, "ws"), ROS_HOME=home,
+                       XDG_RUNTIME_DIR=root, ROS_MASTER_URI=uri)
+            env.pop("ROS_LOG_DIR", None)
+            argv = [sys.executable, "-m", "orchestra", "launch", "--no-status", "--disable-title",
+                    *extra, launch]
+        self.t0 = time.perf_counter()
+        self.proc = subprocess.Popen(argv, env=env, stdin=subprocess.DEVNULL,
+                                     stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                                     start_new_session=True)
+        self.ps = psutil.Process(self.proc.pid)
+        self.seen: dict[int, psutil.Process] = {}
+
+    def wait_running(self, n: int, limit: float = 60.0) -> float:
+        """Seconds from Popen until ``n`` node processes run (raises past ``limit``)."""
+        while True:
+            procs = node_procs(self.ps)
+            for proc in procs:
+                self.seen[proc.pid] = proc
+            if len(procs) >= n:
+                return time.perf_counter() - self.t0
+            if self.proc.poll() is not None or time.perf_counter() - self.t0 > limit:
+                raise RuntimeError(f"{self.kind}: {len(procs)} of {n} nodes after "
+                                   f"{time.perf_counter() - self.t0:.1f} s")
+            time.sleep(0.005)
+
+    def everything(self) -> list[psutil.Process]:
+        try:
+            return self.ps.children(recursive=True)
+        except psutil.NoSuchProcess:
+            return []
+
+    def stop(self, limit: float) -> tuple[float, int]:
+        """SIGINT the launcher; seconds until it and every node are gone (capped at ``limit``)
+        and how many nodes were still running at the cap."""
+        nodes = list(self.seen.values())
+        t0 = time.perf_counter()
+        self.proc.send_signal(signal.SIGINT)
+        while time.perf_counter() - t0 < limit:
+            if self.proc.poll() is not None and not alive(nodes):
+                break
+            time.sleep(0.005)
+        took = time.perf_counter() - t0
+        left = len(alive(nodes))
+        self.kill()
+        return took, left
+
+    def kill(self) -> None:
+        """SIGKILL whatever this run started that still runs (launcher, master, nodes)."""
+        procs = self.everything() + list(self.seen.values())
+        ros1.kill_tree(self.proc.pid)
+        for proc in alive(procs):
+            try:
+                proc.kill()
+            except psutil.NoSuchProcess:
+                pass
+        try:
+            self.proc.wait(10)
+        except subprocess.TimeoutExpired:
+            pass
+
+
+def real_roslaunch_comparison(n: int, quick: bool) -> list:
+    """Rows (what, orchestra, roslaunch, note) for section 5."""
+    rows: list = []
+    with tempfile.TemporaryDirectory() as root:
+        launch = make_py_workspace(root, n)
+        # start, then SIGINT stop
+        for kind in ("orchestra", "roslaunch"):
+            run = Launcher(kind, launch, root)
+            try:
+                rows.append([f"start {n} python nodes until all run", kind,
+                             run.wait_running(n)])
+                time.sleep(1.0)  # let the launcher settle (registrations, rosout)
+                took, left = run.stop(40)
+                rows.append([f"SIGINT to launcher -> launcher and {n} nodes gone", kind, took,
+                             f"{left} left" if left else ""])
+            finally:
+                run.kill()
+        # SIGINT-ignoring nodes: default escalation, then --sigint-timeout
+        stubborn = 3
+        launch_x = make_py_workspace(root, 10, stubborn)
+        settings = [((), "default timeouts")] if not quick else []
+        settings.append((("--sigint-timeout", "2", "--sigterm-timeout", "1"),
+                         "--sigint-timeout 2 --sigterm-timeout 1"))
+        for extra, label in settings:
+            for kind in ("orchestra", "roslaunch"):
+                run = Launcher(kind, launch_x, root, extra)
+                try:
+                    run.wait_running(10 + stubborn)
+                    time.sleep(1.0)
+                    took, left = run.stop(40)
+                    rows.append([f"stop 10 nodes + {stubborn} ignoring SIGINT, {label}", kind,
+                                 took, f"{left} left at 40 s cap" if left else ""])
+                finally:
+                    run.kill()
+        # the launcher SIGKILLed: what keeps running
+        for kind in ("orchestra", "roslaunch"):
+            run = Launcher(kind, launch, root)
+            try:
+                run.wait_running(n)
+                time.sleep(1.0)
+                others = [p for p in run.everything() if p.pid not in run.seen]
+                os.kill(run.proc.pid, signal.SIGKILL)
+                run.proc.wait(10)
+                time.sleep(2.0)
+                orphans = len(alive(list(run.seen.values())))
+                other_left = len(alive(others))
+                rows.append([f"launcher SIGKILLed: nodes still running after 2 s (of {n})", kind,
+                             orphans, f"+{other_left} master/rosout processes"])
+            finally:
+                run.kill()
+    merged: dict = {}
+    for what, kind, value, *note in rows:
+        entry = merged.setdefault(what, {"note": []})
+        entry[kind] = value
+        if note and note[0]:
+            entry["note"].append(f"{kind}: {note[0]}")
+    return [(what, e.get("orchestra"), e.get("roslaunch"), "; ".join(e["note"]))
+            for what, e in merged.items()]
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--nodes", type=int, default=100)
     parser.add_argument("--kills", type=int, default=30)
     parser.add_argument("--idle", type=float, default=5.0)
+    parser.add_argument("--quick", action="store_true",
+                        help="fewer kills, shorter idle window, no default-timeout escalation")
     parser.add_argument("--json", action="store_true", help="print the figures as JSON")
     args = parser.parse_args()
+    if args.quick:
+        args.kills, args.idle = min(args.kills, 10), min(args.idle, 2.0)
+    if not args.json:
+        print(ros1.load_average())
     figures: dict[str, float] = {}
     figures.update(cold_start_and_idle_cpu(args.nodes, args.idle))
     figures.update(respawn_latency(args.kills))
     figures.update(stop_time(args.nodes))
+    real_rows = []
+    if ros1.tool("roslaunch") is None:
+        if not args.json:
+            ros1.skip("the real roslaunch comparison", "/usr/bin/roslaunch")
+    else:
+        real_rows = real_roslaunch_comparison(args.nodes, args.quick)
     if args.json:
+        figures["ros1"] = [{"what": w, "orchestra": o, "roslaunch": r, "note": note}
+                           for w, o, r, note in real_rows]
         print(json.dumps(figures, indent=1))
         return
     n = args.nodes
@@ -211,6 +433,16 @@ def main() -> None:
         print(f"{label:<52} {value:>9.3f}s {base:>9.3f}s {value / base:>7.2f}  {target}")
     print(f"{'supervisor CPU, ' + str(n) + ' idle nodes (% of one core)':<52} "
           f"{figures['idle_cpu']:>9.2f}% {'':>10} {'':>7}  < 1 %")
+    if real_rows:
+        print(f"\n{'against real roslaunch (same launch file)':<72} {'orchestra':>10} "
+              f"{'roslaunch':>10} {'ratio':>7}")
+        for what, ours, theirs, note in real_rows:
+            if isinstance(ours, int):
+                print(f"{what:<72} {ours:>10} {theirs:>10} {'':>7}  {note}")
+            else:
+                print(f"{what:<72} {ours:>9.2f}s {theirs:>9.2f}s {theirs / ours:>6.1f}x  {note}")
+        print("ratio = roslaunch time / orchestra time (higher: orchestra faster)")
+    print(ros1.load_average())
 
 
 if __name__ == "__main__":
