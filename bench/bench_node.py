@@ -12,6 +12,12 @@ machines; absolute numbers depend on the CPU and on what else runs.
 Processes: an in-process master, then a publisher process and a subscriber process (or a
 service and a client process). One-way latency = receive time - send time, both read from
 CLOCK_MONOTONIC, which every process on the machine shares.
+
+Against the real ROS 1 rospy (Debian's, run by /usr/bin/python3): the same roles, same
+messages and timing, as rospy->rospy, and mixed (orchestra->rospy, rospy->orchestra); service
+calls/s rospy client->rospy service next to orchestra's. All pairs look each other up through
+the same (orchestra) master, which is not on the measured path. Skipped with a message when
+rospy is missing.
 """
 from __future__ import annotations
 
@@ -27,6 +33,46 @@ import time
 
 HERE = os.path.abspath(__file__)
 IMAGE_BYTES = 640 * 480 * 3
+IMPL = "orchestra"  # the node API a child role uses: "orchestra" or "rospy" (--impl)
+
+
+def node_api():
+    """The rospy-like module of this child: orchestra.node or the real rospy."""
+    if IMPL == "rospy":
+        import rospy
+        return rospy
+    import orchestra.node as api
+    return api
+
+
+def message_class(type_name: str):
+    if IMPL == "rospy":
+        import importlib
+        pkg, name = type_name.split("/")
+        return getattr(importlib.import_module(f"{pkg}.msg"), name)
+    from orchestra.node.msg import get_message_class
+    return get_message_class(type_name)
+
+
+def service_classes(type_name: str):
+    """(service class, response class) in this child's node API."""
+    if IMPL == "rospy":
+        import importlib
+        pkg, name = type_name.split("/")
+        module = importlib.import_module(f"{pkg}.srv")
+        return getattr(module, name), getattr(module, name + "Response")
+    from orchestra.node.msg import get_service_class
+    cls = get_service_class(type_name)
+    return cls, cls.Response
+
+
+def serialized_size(msg) -> int:
+    if hasattr(msg, "serialize_bytes"):
+        return len(msg.serialize_bytes())
+    import io
+    buf = io.BytesIO()
+    msg.serialize(buf)
+    return len(buf.getvalue())
 
 
 def now() -> float:
@@ -48,11 +94,10 @@ def emit(obj: dict) -> None:
 # --- roles run in child processes ----------------------------------------------------------------
 
 def make_message(kind: str):
-    from orchestra.node.msg import get_message_class
     if kind == "twist":
-        return get_message_class("geometry_msgs/Twist")()
-    img = get_message_class("sensor_msgs/Image")(height=480, width=640, encoding="rgb8",
-                                                  step=640 * 3, data=bytes(IMAGE_BYTES))
+        return message_class("geometry_msgs/Twist")()
+    img = message_class("sensor_msgs/Image")(height=480, width=640, encoding="rgb8",
+                                             step=640 * 3, data=bytes(IMAGE_BYTES))
     return img
 
 
@@ -72,7 +117,7 @@ def read_stamp(kind: str, msg) -> float:
 def role_sub(kind: str, count: int, burst: int) -> None:
     import threading
 
-    import orchestra.node as rospy
+    rospy = node_api()
     msg = make_message(kind)
     latencies: list[float] = []
     burst_times: list[float] = []
@@ -98,12 +143,12 @@ def role_sub(kind: str, count: int, burst: int) -> None:
     received = len(burst_times) - 1
     span = burst_times[-1] - burst_times[0] if received > 0 else float("nan")
     emit({"throughput": {"received": received, "msgs_per_s": received / span,
-                         "mb_per_s": received * len(msg.serialize_bytes()) / span / 1e6}})
+                         "mb_per_s": received * serialized_size(msg) / span / 1e6}})
     rospy.signal_shutdown("done")
 
 
 def role_pub(kind: str, count: int, burst: int) -> None:
-    import orchestra.node as rospy
+    rospy = node_api()
     msg = make_message(kind)
     rospy.init_node(f"bench_pub_{kind}", disable_signals=True)
     pub = rospy.Publisher("/bench", type(msg), queue_size=burst)
@@ -126,30 +171,31 @@ def role_pub(kind: str, count: int, burst: int) -> None:
     pub.publish(msg)  # the first burst message carries the start time
     for _ in range(burst - 1):
         pub.publish(msg)
-    impl = pub._impl
+    impl = getattr(pub, "_impl", None)
     deadline = now() + 30
-    while now() < deadline and any(c.queue for c in impl.connections):
-        time.sleep(0.01)
+    if IMPL == "orchestra":
+        while now() < deadline and any(c.queue for c in impl.connections):
+            time.sleep(0.01)
+    # rospy's publish() hands each message to the connection's writer thread; the parent
+    # waits for the subscriber's count either way
     emit({"burst_sent": burst})
     sys.stdin.readline()
     rospy.signal_shutdown("done")
 
 
 def role_service() -> None:
-    import orchestra.node as rospy
-    from orchestra.node.msg import get_service_class
-    Trigger = get_service_class("std_srvs/SetBool")
+    rospy = node_api()
+    SetBool, Response = service_classes("std_srvs/SetBool")
     rospy.init_node("bench_service", disable_signals=True)
-    rospy.Service("/bench_srv", Trigger, lambda req: Trigger.Response(success=req.data))
+    rospy.Service("/bench_srv", SetBool, lambda req: Response(success=req.data))
     emit({"ready": True})
     sys.stdin.readline()
     rospy.signal_shutdown("done")
 
 
 def role_client(calls: int) -> None:
-    import orchestra.node as rospy
-    from orchestra.node.msg import get_service_class
-    SetBool = get_service_class("std_srvs/SetBool")
+    rospy = node_api()
+    SetBool, _ = service_classes("std_srvs/SetBool")
     rospy.init_node("bench_client", disable_signals=True)
     rospy.wait_for_service("/bench_srv", timeout=10)
     out = {}
@@ -230,9 +276,16 @@ def raw_baseline(size: int, count: int, burst: int, calls: int, gap: float) -> d
 
 # --- driver ---------------------------------------------------------------------------------------
 
-def child(env: dict, *args: str) -> subprocess.Popen:
-    return subprocess.Popen([sys.executable, HERE, *args], env=env, stdin=subprocess.PIPE,
-                            stdout=subprocess.PIPE, text=True)
+def child(env: dict, *args: str, impl: str = "orchestra") -> subprocess.Popen:
+    """A role in a child process: orchestra's interpreter, or the ROS 1 one for rospy."""
+    if impl == "rospy":
+        import ros1
+        python = ros1.ROS1_PYTHON
+        env = ros1.base_env(ROS_MASTER_URI=env["ROS_MASTER_URI"], PYTHONUNBUFFERED="1")
+    else:
+        python = sys.executable
+    return subprocess.Popen([python, HERE, "--impl", impl, *args], env=env,
+                            stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
 
 
 def read(proc: subprocess.Popen, key: str) -> dict:
@@ -250,12 +303,15 @@ def tell(proc: subprocess.Popen, text: str = "") -> None:
     proc.stdin.flush()
 
 
-def bench_topic(env: dict, kind: str, count: int, burst: int) -> dict:
-    sub = child(env, "--role", "sub", "--kind", kind, "--count", str(count), "--burst", str(burst))
+def bench_topic(env: dict, kind: str, count: int, burst: int, pub_impl: str = "orchestra",
+                sub_impl: str = "orchestra") -> dict:
+    sub = child(env, "--role", "sub", "--kind", kind, "--count", str(count), "--burst", str(burst),
+                impl=sub_impl)
     read(sub, "ready")
-    pub = child(env, "--role", "pub", "--kind", kind, "--count", str(count), "--burst", str(burst))
+    pub = child(env, "--role", "pub", "--kind", kind, "--count", str(count), "--burst", str(burst),
+                impl=pub_impl)
     read(pub, "latency_sent")
-    tell(sub, "latency done 30")
+    tell(sub, "latency done 20")
     latency = read(sub, "latency")["latency"]
     tell(pub)
     read(pub, "burst_sent")
@@ -275,8 +331,12 @@ def main() -> None:
     parser.add_argument("--size", type=int, default=48)
     parser.add_argument("--calls", type=int, default=2000)
     parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--impl", default="orchestra", choices=("orchestra", "rospy"),
+                        help="(child roles) the node API to use")
     parser.add_argument("--json", action="store_true", help="Print one JSON document.")
     opts = parser.parse_args()
+    global IMPL
+    IMPL = opts.impl
     if opts.role == "sub":
         return role_sub(opts.kind, opts.count, opts.burst)
     if opts.role == "pub":
@@ -299,15 +359,21 @@ def main() -> None:
         for kind, (count, burst, size, gap) in plan.items():
             results[kind] = bench_topic(env, kind, count, burst)
             results[kind]["baseline"] = raw_baseline(size, count, burst, 10, gap)
-        svc = child(env, "--role", "service")
-        read(svc, "ready")
         calls = int(opts.calls * scale)
-        cli = child(env, "--role", "client", "--calls", str(calls))
-        results["service"] = read(cli, "calls_per_s")["calls_per_s"]
-        cli.wait(30)
-        tell(svc)
-        svc.wait(15)
+        results["service"] = bench_service(env, calls)
         results["service"]["baseline"] = raw_baseline(8, 1, 2, calls, 0)["calls_per_s"]
+        import ros1
+        if ros1.has_modules("rospy", "geometry_msgs.msg", "sensor_msgs.msg", "std_srvs.srv"):
+            results["ros1"] = {}
+            for kind, (count, burst, _, _) in plan.items():
+                for pub_impl, sub_impl in PAIRS[1:]:
+                    results["ros1"][f"{kind} {pub_impl}->{sub_impl}"] = bench_topic(
+                        env, kind, count, burst, pub_impl, sub_impl)
+            for cli_impl, svc_impl in PAIRS[1:]:
+                results["ros1"][f"service {cli_impl}->{svc_impl}"] = bench_service(
+                    env, calls, svc_impl, cli_impl)
+        else:
+            ros1.skip("rospy comparisons", "rospy (with geometry_msgs, sensor_msgs, std_srvs)")
     finally:
         master.shutdown()
     if opts.json:
@@ -332,6 +398,68 @@ def main() -> None:
         print(f"{'service calls/s ' + key:36}{s[key]:14.0f}{s['baseline']:14.0f}"
               f"{s['baseline'] / s[key]:9.1f}")
     print("ratio = how many times slower than the bare-socket baseline (lower is better)")
+    if "ros1" in results:
+        print_ros1(results, plan)
+    print(load_average())
+
+
+PAIRS = [("orchestra", "orchestra"), ("rospy", "rospy"), ("orchestra", "rospy"),
+         ("rospy", "orchestra")]
+
+
+def bench_service(env: dict, calls: int, svc_impl: str = "orchestra",
+                  cli_impl: str = "orchestra") -> dict:
+    svc = child(env, "--role", "service", impl=svc_impl)
+    try:
+        read(svc, "ready")
+        cli = child(env, "--role", "client", "--calls", str(calls), impl=cli_impl)
+        result = read(cli, "calls_per_s")["calls_per_s"]
+        cli.wait(30)
+        tell(svc)
+        svc.wait(15)
+    finally:
+        for proc in (svc, locals().get("cli")):
+            if proc is not None and proc.poll() is None:
+                proc.kill()
+                proc.wait()
+    return result
+
+
+def load_average() -> str:
+    one, five, fifteen = os.getloadavg()
+    return f"load average {one:.2f} {five:.2f} {fifteen:.2f} on {os.cpu_count()} cores"
+
+
+def print_ros1(results: dict, plan: dict) -> None:
+    """orchestra->orchestra next to rospy->rospy and the mixed pairs (pub->sub)."""
+    short = {"orchestra": "orch", "rospy": "rospy"}
+    cols = [f"{short[a]}->{short[b]}" for a, b in PAIRS]
+    print(f"\n{'against real rospy (pub->sub, cli->srv)':36.36}" + "".join(f"{c:>14}" for c in cols)
+          + f"{'rospy/orch':>12}")
+    for kind, label in (("twist", "Twist"), ("image", "Image 640x480")):
+        runs = [results[kind]] + [results["ros1"][f"{kind} {a}->{b}"] for a, b in PAIRS[1:]]
+        for key, name, fmt, better_low in (
+                ("median_us", "latency median (us)", "14.0f", True),
+                ("p99_us", "latency p99 (us)", "14.0f", True),
+                ("msgs_per_s", "msgs/s", "14.0f", False),
+                ("mb_per_s", "MB/s", "14.1f", False),
+                ("received", "received of sent", "14d", False)):
+            part = "latency" if key.endswith("_us") else "throughput"
+            values = [r[part][key] for r in runs]
+            line = f"{label + ' ' + name:36.36}" + "".join(format(v, fmt) for v in values)
+            if key == "received":
+                line += f"{plan[kind][1]:>12}"
+            elif values[0] and values[1]:
+                ratio = values[1] / values[0] if better_low else values[0] / values[1]
+                line += f"{ratio:11.1f}x"
+            print(line)
+    svc = [results["service"]] + [results["ros1"][f"service {a}->{b}"] for a, b in PAIRS[1:]]
+    for key in ("plain", "persistent"):
+        values = [r[key] for r in svc]
+        print(f"{'service calls/s ' + key + ' (cli->srv)':36.36}"
+              + "".join(f"{v:14.0f}" for v in values) + f"{values[0] / values[1]:11.1f}x")
+    print("rospy/orch = how many times orchestra->orchestra beats rospy->rospy (higher: "
+          "orchestra better)")
 
 
 if __name__ == "__main__":
