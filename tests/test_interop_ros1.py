@@ -365,6 +365,26 @@ def test_real_rostopic_lists_inspects_echoes_and_publishes_with_orchestra_nodes(
     got = cmd.expect(lambda d: "msg" in d and d["callerid"].startswith("/rostopic_"))
     assert got["msg"]["linear"]["x"] == 0.25
     pub.signal(signal.SIGINT)
+    # rostopic hz subscribes with rospy.AnyMsg (type "*"): orchestra serves it too
+    hz = side.background_tool("rostopic", "hz", "/chatter")
+    rate = hz.expect(lambda d: d.get("text", "").startswith("average rate:"), timeout=10)
+    assert 10 < float(rate["text"].split(":")[1]) < 30
+    hz.signal(signal.SIGINT)
+
+
+def test_real_rostopic_echo_prints_what_orchestra_topic_echo_prints(side):
+    side.orch("--name", "poser", "pub", "poses", "geometry_msgs/PoseArray",
+              TOPIC_CASES["geometry_msgs/PoseArray"][0]).ready()
+    side.orch("--name", "greeter", "pub", "greeting", "std_msgs/String",
+              "data: 'two words: here'").ready()
+
+    def without_seq(text: str) -> str:
+        return "\n".join(line for line in text.splitlines() if "seq:" not in line)
+    for topic in ("/poses", "/greeting"):
+        real = side.tool("rostopic", "echo", "-n", "1", topic)
+        ours = side.orchestra("topic", "echo", "-n", "1", topic)
+        assert real.returncode == 0 and ours.returncode == 0, real.stderr + ours.stderr
+        assert without_seq(ours.stdout) == without_seq(real.stdout)
 
 
 def test_real_rosparam_sets_gets_dumps_and_loads_on_orchestra_master(side, master, tmp_path):
@@ -398,6 +418,9 @@ def test_real_rosservice_lists_and_calls_orchestra_services(side):
     assert typ.stdout == "std_srvs/SetBool\n"
     call = side.tool("rosservice", "call", "/set_bool", "data: true")
     assert (call.returncode, call.stdout) == (0, 'success: True\nmessage: "orchestra call 1"\n')
+    info = side.tool("rosservice", "info", "/set_bool")
+    assert "Node: /server\n" in info.stdout and "Type: std_srvs/SetBool\n" in info.stdout
+    assert "Args: data\n" in info.stdout
     failed = side.tool("rosservice", "call", "/set_bool", "data: false")
     assert failed.returncode != 0
     assert "refused by orchestra" in failed.stderr + failed.stdout
@@ -580,15 +603,29 @@ DUMP_ENV = {"ROS_PACKAGE_PATH": str(REPO / "packages"),
             "ROS_MASTER_URI": "http://localhost:11311/"}
 
 
-@pytest.fixture(scope="module")
-def roslaunch_dumps(tmp_path_factory) -> dict:
-    """--nodes/--dump-params/--files/--args of every demo, from real roslaunch (one process)."""
+@pytest.fixture(scope="module", autouse=True)
+def _roslaunch_resolving(tmp_path_factory):
+    """Real roslaunch resolving every demo, started with the module's first test.
+
+    It takes seconds (roslaunch re-runs xacro and every substitution per option), so it runs
+    in the background while the other tests do; ``roslaunch_dumps`` collects the answer.
+    """
     home = tmp_path_factory.mktemp("ros_home")
-    result = subprocess.run([ROS_PYTHON, str(HERE / "ros1_nodes" / "roslaunch_resolve.py"),
+    proc = subprocess.Popen([ROS_PYTHON, str(HERE / "ros1_nodes" / "roslaunch_resolve.py"),
                              *DEMOS], env=_ros_env(dict(DUMP_ENV, ROS_HOME=str(home))),
-                            capture_output=True, text=True, timeout=50)
-    assert result.returncode == 0, result.stderr
-    return json.loads(result.stdout)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    yield proc
+    if proc.poll() is None:
+        proc.kill()
+    proc.communicate()
+
+
+@pytest.fixture(scope="module")
+def roslaunch_dumps(_roslaunch_resolving) -> dict:
+    """--nodes/--dump-params/--files/--args of every demo, from real roslaunch (one process)."""
+    out, err = _roslaunch_resolving.communicate(timeout=60)
+    assert _roslaunch_resolving.returncode == 0, err
+    return json.loads(out)
 
 
 def _orchestra_dumps(words: str, nodes: list[str]) -> dict:
