@@ -187,6 +187,34 @@ def test_rospy_node_registers_and_lookup_node_returns_its_slave_api(side):
     assert ["/chatter", "std_msgs/String"] in topics
 
 
+def test_rospy_node_unregisters_from_orchestra_master_when_it_shuts_down(side):
+    talker = side.rospy("--name", "talker", "pub", "chatter", "std_msgs/String", "data: hi")
+    server = side.rospy("--name", "server", "serve", "empty", "std_srvs/Empty")
+    talker.ready()
+    server.ready()
+    talker.signal(signal.SIGINT)
+    server.signal(signal.SIGINT)
+    assert talker.wait(10) == 0 and server.wait(10) == 0
+    pubs, subs, srvs = side.master().getSystemState("/probe")[2]
+    assert not [t for t, nodes in pubs + subs + srvs if {"/talker", "/server"} & set(nodes)]
+    assert side.master().lookupNode("/probe", "/talker")[0] != 1
+
+
+@pytest.mark.parametrize("masters", ["orchestra_master", "real_rosmaster"])
+def test_a_node_registering_a_taken_name_shuts_the_old_one_down(masters, request):
+    """The master calls shutdown on the old node; rospy and orchestra nodes both obey."""
+    group = request.getfixturevalue("side" if masters == "orchestra_master" else "real_side")
+    old_rospy = group.rospy("--name", "twin", "pub", "a", "std_msgs/String", "data: x")
+    old_rospy.ready()
+    old_orch = group.orch("--name", "twin", "pub", "b", "std_msgs/String", "data: x")
+    old_orch.ready()
+    old_rospy.wait(10)  # the orchestra node took /twin from the rospy node ...
+    group.rospy("--name", "twin", "pub", "c", "std_msgs/String", "data: x").ready()
+    old_orch.wait(10)   # ... and a rospy node took it back
+    _, _, uri = group.master().lookupNode("/probe", "/twin")
+    assert xmlrpc.client.ServerProxy(uri).getPid("/probe")[2] == group.procs[-1].proc.pid
+
+
 def _seed_params(params) -> None:
     params.set("/interop/ns/talker/gains", {"p": 1.5, "i": [0, 1]})
     params.set("/interop/ns/relative", "in ns")
@@ -260,6 +288,15 @@ TOPIC_CASES = {
         and m["header"]["stamp"] == {"secs": 12, "nsecs": 34}
         and len(m["poses"]) == 2 and m["poses"][1]["orientation"]["z"] == 0.5
         and m["poses"][0]["position"] == {"x": 1.0, "y": 0.0, "z": 0.0}),
+    "std_msgs/Float64MultiArray": (
+        "{layout: {dim: [{label: rows, size: 2, stride: 4}, {label: cols, size: 2, stride: 2}],"
+        " data_offset: 1}, data: [0.5, -1.0, 1.0e+300, 3.25]}",
+        lambda m: m == {"layout": {"dim": [{"label": "rows", "size": 2, "stride": 4},
+                                           {"label": "cols", "size": 2, "stride": 2}],
+                                   "data_offset": 1},
+                        "data": [0.5, -1.0, 1e300, 3.25]}),
+    "std_msgs/UInt8MultiArray": ("{data: [0, 1, 254, 255]}",
+                                 lambda m: m["data"] == [0, 1, 254, 255]),
 }
 
 
@@ -591,6 +628,41 @@ def test_orchestra_launch_waits_for_an_external_rosmaster_and_uploads_params(tmp
             except subprocess.TimeoutExpired:
                 rosmaster.kill()
                 rosmaster.wait()
+
+
+def test_real_roslaunch_runs_a_launch_file_against_orchestra_core(tmp_path):
+    port = free_port()
+    uri = f"http://127.0.0.1:{port}/"
+    out, log, core_log = tmp_path / "report.json", tmp_path / "roslaunch.log", \
+        tmp_path / "core.log"
+    home = {"ROS_HOME": str(tmp_path / "ros_home"), "ROS_PACKAGE_PATH": ROS1_PACKAGES,
+            "ROS_MASTER_URI": uri}
+    with open(core_log, "w") as clog:
+        core = subprocess.Popen([sys.executable, "-m", "orchestra", "core", "-p", str(port)],
+                                env=dict(os.environ, **home), stdout=clog,
+                                stderr=subprocess.STDOUT)
+    roslaunch = None
+    try:
+        wait_for(lambda: "master ready" in core_log.read_text(), timeout=15)
+        with open(log, "w") as rlog:
+            roslaunch = subprocess.Popen(
+                [ROS_PYTHON, "/usr/bin/roslaunch", str(REPORT_LAUNCH), f"out:={out}"],
+                env=_ros_env(home), stdout=rlog, stderr=subprocess.STDOUT)
+        report = _wait_for_file(out, roslaunch, log)
+        assert report["private"] == {"rate": 5.5, "label": "007",
+                                     "config": {"a": 1, "b": ["x", "y"]}}
+        assert report["published"] == ["/robot/speech", "/rosout"]
+        master = xmlrpc.client.ServerProxy(uri)
+        # roslaunch found orchestra core's /run_id and registered its own server node
+        run_id = master.getParam("/probe", "/run_id")[2]
+        assert run_id in log.read_text()
+        assert _stop(roslaunch) == 0, log.read_text()[-2000:]
+        pubs = master.getSystemState("/probe")[2][0]
+        assert not [t for t, nodes in pubs if "/robot/reporter" in nodes]
+    finally:
+        if roslaunch is not None:
+            _stop(roslaunch)
+        _stop(core)
 
 
 # --- 6. real roslaunch resolving orchestra's bundled demos ----------------------------------
