@@ -369,9 +369,15 @@ def main() -> None:
                 for pub_impl, sub_impl in PAIRS[1:]:
                     results["ros1"][f"{kind} {pub_impl}->{sub_impl}"] = bench_topic(
                         env, kind, count, burst, pub_impl, sub_impl)
-            for cli_impl, svc_impl in PAIRS[1:]:
-                results["ros1"][f"service {cli_impl}->{svc_impl}"] = bench_service(
-                    env, calls, svc_impl, cli_impl)
+            # service pairs interleaved over rounds, best kept (the shared machine's load
+            # swings these by 2x from one run to the next); orchestra->orchestra included
+            for _ in range(1 if opts.quick else 3):
+                for cli_impl, svc_impl in PAIRS:
+                    got = bench_service(env, calls, svc_impl, cli_impl)
+                    key = f"service {cli_impl}->{svc_impl}"
+                    best = results["ros1"].setdefault(key, dict.fromkeys(got, 0.0))
+                    for k, v in got.items():
+                        best[k] = max(best[k], v)
         else:
             ros1.skip("rospy comparisons", "rospy (with geometry_msgs, sensor_msgs, std_srvs)")
     finally:
@@ -453,10 +459,10 @@ def print_ros1(results: dict, plan: dict) -> None:
                 ratio = values[1] / values[0] if better_low else values[0] / values[1]
                 line += f"{ratio:11.1f}x"
             print(line)
-    svc = [results["service"]] + [results["ros1"][f"service {a}->{b}"] for a, b in PAIRS[1:]]
+    svc = [results["ros1"][f"service {a}->{b}"] for a, b in PAIRS]
     for key in ("plain", "persistent"):
         values = [r[key] for r in svc]
-        print(f"{'service calls/s ' + key + ' (cli->srv)':36.36}"
+        print(f"{'service calls/s ' + key + ', best':36.36}"
               + "".join(f"{v:14.0f}" for v in values) + f"{values[0] / values[1]:11.1f}x")
     print("rospy/orch = how many times orchestra->orchestra beats rospy->rospy (higher: "
           "orchestra better)")
