@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shlex
 import signal
 import socket
@@ -95,6 +96,31 @@ class Side:
     def orchestra(self, *args: str, timeout: float = 20) -> subprocess.CompletedProcess:
         return subprocess.run([sys.executable, "-m", "orchestra", *args], env=self.orch_env,
                               capture_output=True, text=True, timeout=timeout)
+
+    def run_all(self, *commands: tuple[str, ...], timeout: float = 20
+                ) -> list[subprocess.CompletedProcess]:
+        """Several commands at once (each a real tool, or ``orchestra ...``), in order.
+
+        Independent look-ups run concurrently: a real ROS tool costs half a second of
+        interpreter start-up, and the module must stay fast.
+        """
+        procs = []
+        for argv in commands:
+            if argv[0] == "orchestra":
+                full, env = [sys.executable, "-m", "orchestra", *argv[1:]], self.orch_env
+            else:
+                full, env = [ROS_PYTHON, f"/usr/bin/{argv[0]}", *argv[1:]], self.ros_env
+            procs.append(subprocess.Popen(full, env=env, stdout=subprocess.PIPE,
+                                          stderr=subprocess.PIPE, text=True))
+        results = []
+        for argv, proc in zip(commands, procs):
+            try:
+                out, err = proc.communicate(timeout=timeout)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                out, err = proc.communicate()
+            results.append(subprocess.CompletedProcess(argv, proc.returncode, out, err))
+        return results
 
     def background_tool(self, *argv: str) -> NodeProcess:
         return self._start([ROS_PYTHON, f"/usr/bin/{argv[0]}", *argv[1:]], self.ros_env)
@@ -355,24 +381,25 @@ def _drain(proc: NodeProcess) -> list[dict]:
 
 # --- 3. services both ways ------------------------------------------------------------------
 
-@pytest.mark.parametrize("persistent", [False, True], ids=["plain", "persistent"])
 @pytest.mark.parametrize("direction", ["rospy_serves", "orchestra_serves"])
-def test_service_calls_cross_between_rospy_and_orchestra(side, direction, persistent):
+def test_service_calls_cross_between_rospy_and_orchestra(side, direction):
     serve, call = ((side.rospy, side.orch) if direction == "rospy_serves"
                    else (side.orch, side.rospy))
     server_impl = "rospy" if direction == "rospy_serves" else "orchestra"
     serve("--name", "server", "serve", "set_bool", "std_srvs/SetBool")
     serve("--name", "emptyserver", "serve", "empty", "std_srvs/Empty")
-    extra = ("--persistent",) if persistent else ()
-    caller = call("--name", "caller", "call", "/set_bool", "std_srvs/SetBool",
-                  "{data: true}", "{data: false}", "{data: true}", *extra)
+    requests = ("{data: true}", "{data: false}", "{data: true}")
+    callers = [call("--name", f"caller{i}", "call", "/set_bool", "std_srvs/SetBool",
+                    *requests, *extra) for i, extra in enumerate([(), ("--persistent",)])]
     empty = call("--name", "ecaller", "call", "/empty", "std_srvs/Empty", "{}", "{}")
-    results = caller.expect(lambda d: "results" in d, timeout=15)["results"]
-    assert results[0] == {"ok": {"success": True, "message": f"{server_impl} call 1"}}
-    # the handler's exception reaches the caller as ServiceException with its text
-    assert "refused by " + server_impl in results[1]["error"]
-    # the server survived the exception (and, persistent, kept the same connection)
-    assert results[2] == {"ok": {"success": True, "message": f"{server_impl} call 3"}}
+    ok = re.compile(f"{server_impl} call [1-6]")
+    for caller in callers:  # one plain proxy, one persistent (all calls on one connection)
+        results = caller.expect(lambda d: "results" in d, timeout=15)["results"]
+        assert results[0]["ok"]["success"] and ok.fullmatch(results[0]["ok"]["message"])
+        # the handler's exception reaches the caller as ServiceException with its text
+        assert "refused by " + server_impl in results[1]["error"]
+        # the server survived the exception (persistent: on the same connection)
+        assert results[2]["ok"]["success"] and ok.fullmatch(results[2]["ok"]["message"])
     assert empty.expect(lambda d: "results" in d, timeout=15)["results"] == [{"ok": {}}] * 2
 
 
@@ -386,24 +413,23 @@ def test_real_rostopic_lists_inspects_echoes_and_publishes_with_orchestra_nodes(
     cmd.ready()
     pub = side.background_tool("rostopic", "pub", "-r", "10", "/cmd", "geometry_msgs/Twist",
                                "{linear: {x: 0.25}}")
-    listed = side.tool("rostopic", "list")
+    # rostopic hz subscribes with rospy.AnyMsg (type "*"): orchestra serves it too
+    hz = side.background_tool("rostopic", "hz", "/chatter")
+    listed, info, echo, typ = side.run_all(
+        ("rostopic", "list"), ("rostopic", "info", "/chatter"),
+        ("rostopic", "echo", "-n", "2", "/chatter"), ("rostopic", "type", "/chatter"))
     assert listed.returncode == 0, listed.stderr
     assert {"/chatter", "/cmd"} <= set(listed.stdout.split())
-    info = side.tool("rostopic", "info", "/chatter")
     assert info.returncode == 0, info.stderr
     assert "Type: std_msgs/String" in info.stdout
     pubs, subs = info.stdout.split("Subscribers:")
     assert " * /talker (http://" in pubs and " * /listener (http://" in subs
-    echo = side.tool("rostopic", "echo", "-n", "2", "/chatter")
     assert echo.returncode == 0, echo.stderr
     assert echo.stdout == 'data: "hello"\n---\ndata: "hello"\n---\n'
-    typ = side.tool("rostopic", "type", "/chatter")
     assert typ.stdout == "std_msgs/String\n"
     got = cmd.expect(lambda d: "msg" in d and d["callerid"].startswith("/rostopic_"))
     assert got["msg"]["linear"]["x"] == 0.25
     pub.signal(signal.SIGINT)
-    # rostopic hz subscribes with rospy.AnyMsg (type "*"): orchestra serves it too
-    hz = side.background_tool("rostopic", "hz", "/chatter")
     rate = hz.expect(lambda d: d.get("text", "").startswith("average rate:"), timeout=10)
     assert 10 < float(rate["text"].split(":")[1]) < 30
     hz.signal(signal.SIGINT)
@@ -417,9 +443,10 @@ def test_real_rostopic_echo_prints_what_orchestra_topic_echo_prints(side):
 
     def without_seq(text: str) -> str:
         return "\n".join(line for line in text.splitlines() if "seq:" not in line)
-    for topic in ("/poses", "/greeting"):
-        real = side.tool("rostopic", "echo", "-n", "1", topic)
-        ours = side.orchestra("topic", "echo", "-n", "1", topic)
+    results = side.run_all(*[(tool, verb, *(["echo"] if tool == "orchestra" else []), "-n", "1",
+                               topic) for topic in ("/poses", "/greeting")
+                             for tool, verb in (("rostopic", "echo"), ("orchestra", "topic"))])
+    for real, ours in zip(results[::2], results[1::2]):
         assert real.returncode == 0 and ours.returncode == 0, real.stderr + ours.stderr
         assert without_seq(ours.stdout) == without_seq(real.stdout)
 
@@ -447,18 +474,18 @@ def test_real_rosparam_sets_gets_dumps_and_loads_on_orchestra_master(side, maste
 
 def test_real_rosservice_lists_and_calls_orchestra_services(side):
     side.orch("--name", "server", "serve", "set_bool", "std_srvs/SetBool").ready()
-    listed = side.tool("rosservice", "list")
+    listed, typ, call, info, failed = side.run_all(
+        ("rosservice", "list"), ("rosservice", "type", "/set_bool"),
+        ("rosservice", "call", "/set_bool", "data: true"), ("rosservice", "info", "/set_bool"),
+        ("rosservice", "call", "/set_bool", "data: false"))
     assert listed.returncode == 0, listed.stderr
     assert "/set_bool" in listed.stdout.split()
     assert "/server/get_loggers" not in listed.stdout  # orchestra offers no logger services
-    typ = side.tool("rosservice", "type", "/set_bool")
     assert typ.stdout == "std_srvs/SetBool\n"
-    call = side.tool("rosservice", "call", "/set_bool", "data: true")
-    assert (call.returncode, call.stdout) == (0, 'success: True\nmessage: "orchestra call 1"\n')
-    info = side.tool("rosservice", "info", "/set_bool")
+    assert call.returncode == 0, call.stderr
+    assert re.fullmatch(r'success: True\nmessage: "orchestra call [12]"\n', call.stdout)
     assert "Node: /server\n" in info.stdout and "Type: std_srvs/SetBool\n" in info.stdout
     assert "Args: data\n" in info.stdout
-    failed = side.tool("rosservice", "call", "/set_bool", "data: false")
     assert failed.returncode != 0
     assert "refused by orchestra" in failed.stderr + failed.stdout
 
@@ -468,9 +495,8 @@ def test_real_rosnode_lists_inspects_and_kills_orchestra_nodes(side):
     side.orch("--name", "listener", "sub", "chatter", "std_msgs/String").expect(
         lambda d: "msg" in d)
     talker.ready()
-    listed = side.tool("rosnode", "list")
+    listed, info = side.run_all(("rosnode", "list"), ("rosnode", "info", "/talker"))
     assert {"/talker", "/listener"} <= set(listed.stdout.split()), listed
-    info = side.tool("rosnode", "info", "/talker")
     assert info.returncode == 0, info.stderr
     assert "Publications: \n * /chatter [std_msgs/String]" in info.stdout
     assert f"Pid: {talker.proc.pid}" in info.stdout
@@ -489,36 +515,39 @@ def test_orchestra_tools_work_against_a_real_rosmaster_and_rospy_nodes(real_side
     listener = side.rospy("--name", "listener", "sub", "cmd", "std_msgs/String")
     for proc in (talker, server, listener):
         proc.ready()
-    topics = side.orchestra("topic", "list")
+    dump = tmp_path / "dump.yaml"
+    setting = side.orchestra("param", "set", "/robot/gains", "{p: 2, d: [1, 2]}")
+    assert setting.returncode == 0, setting.stderr
+    (topics, info, echo, pub, got, ours_get, real_get, dumped, services, call, refused, nodes,
+     node_info) = side.run_all(
+        ("orchestra", "topic", "list"), ("orchestra", "topic", "info", "/chatter"),
+        ("orchestra", "topic", "echo", "/chatter/linear/x", "-n", "1"),
+        ("orchestra", "topic", "pub", "-1", "/cmd", "std_msgs/String", "data: from us"),
+        ("rosparam", "get", "/robot/gains/p"), ("orchestra", "param", "get", "/robot/gains"),
+        ("rosparam", "get", "/robot/gains"),
+        ("orchestra", "param", "dump", str(dump), "/robot"),
+        ("orchestra", "service", "list"),
+        ("orchestra", "service", "call", "/set_bool", "data: true"),
+        ("orchestra", "service", "call", "/set_bool", "data: false"),
+        ("orchestra", "node", "list"), ("orchestra", "node", "info", "/talker"))
     assert topics.returncode == 0, topics.stderr
     assert {"/chatter", "/cmd", "/rosout"} <= set(topics.stdout.split())
-    info = side.orchestra("topic", "info", "/chatter")
     assert "Type: geometry_msgs/Twist" in info.stdout and " * /talker (http://" in info.stdout
-    echo = side.orchestra("topic", "echo", "/chatter/linear/x", "-n", "1")
     assert (echo.returncode, echo.stdout) == (0, "1.5\n---\n"), echo.stderr
-    pub = side.orchestra("topic", "pub", "-1", "/cmd", "std_msgs/String", "data: from us")
     assert pub.returncode == 0, pub.stderr
     assert listener.expect(lambda d: "msg" in d)["msg"] == {"data": "from us"}
 
-    assert side.orchestra("param", "set", "/robot/gains", "{p: 2, d: [1, 2]}").returncode == 0
-    got = side.tool("rosparam", "get", "/robot/gains/p")
     assert got.stdout == "2\n"
-    assert side.orchestra("param", "get", "/robot/gains").stdout == \
-        side.tool("rosparam", "get", "/robot/gains").stdout
-    dump = tmp_path / "dump.yaml"
-    assert side.orchestra("param", "dump", str(dump), "/robot").returncode == 0
+    assert ours_get.stdout == real_get.stdout
+    assert dumped.returncode == 0, dumped.stderr
     assert yaml.safe_load(dump.read_text()) == {"gains": {"p": 2, "d": [1, 2]}}
 
-    services = side.orchestra("service", "list")
     assert "/set_bool" in services.stdout.split(), services.stderr
-    call = side.orchestra("service", "call", "/set_bool", "data: true")
-    assert (call.returncode, call.stdout) == (0, 'success: True\nmessage: "rospy call 1"\n')
-    refused = side.orchestra("service", "call", "/set_bool", "data: false")
+    assert call.returncode == 0, call.stderr
+    assert re.fullmatch(r'success: True\nmessage: "rospy call [12]"\n', call.stdout)
     assert refused.returncode == 1 and "refused by rospy" in refused.stderr
 
-    nodes = side.orchestra("node", "list")
     assert {"/talker", "/server", "/listener"} <= set(nodes.stdout.split())
-    node_info = side.orchestra("node", "info", "/talker")
     assert node_info.returncode == 0, node_info.stderr
     assert f"Pid: {talker.proc.pid}" in node_info.stdout
     assert " * /chatter [geometry_msgs/Twist]" in node_info.stdout
@@ -675,60 +704,52 @@ DUMP_ENV = {"ROS_PACKAGE_PATH": str(REPO / "packages"),
             "ROS_MASTER_URI": "http://localhost:11311/"}
 
 
-@pytest.fixture(scope="module", autouse=True)
-def _roslaunch_resolving(tmp_path_factory):
-    """Real roslaunch resolving every demo, started with the module's first test.
-
-    It takes seconds (roslaunch re-runs xacro and every substitution per option), so it runs
-    in the background while the other tests do; ``roslaunch_dumps`` collects the answer.
-    """
-    home = tmp_path_factory.mktemp("ros_home")
-    proc = subprocess.Popen([ROS_PYTHON, str(HERE / "ros1_nodes" / "roslaunch_resolve.py"),
-                             *DEMOS], env=_ros_env(dict(DUMP_ENV, ROS_HOME=str(home))),
+def _start_resolving(interpreter: str, script: str, env: dict[str, str]) -> subprocess.Popen:
+    return subprocess.Popen([interpreter, str(HERE / "ros1_nodes" / script), *DEMOS], env=env,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    yield proc
-    if proc.poll() is None:
-        proc.kill()
-    proc.communicate()
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _resolving(tmp_path_factory):
+    """Real roslaunch and orchestra resolving every demo, started with the module's first test.
+
+    Real roslaunch takes seconds (it re-runs xacro and every substitution per option), so
+    both run in the background while the other tests do; ``dumps`` collects the answers.
+    """
+    home = str(tmp_path_factory.mktemp("ros_home"))
+    procs = {"roslaunch": _start_resolving(ROS_PYTHON, "roslaunch_resolve.py",
+                                           _ros_env(dict(DUMP_ENV, ROS_HOME=home))),
+             "orchestra": _start_resolving(sys.executable, "orchestra_resolve.py",
+                                           dict(os.environ, ROS_HOME=home, **DUMP_ENV))}
+    yield procs
+    for proc in procs.values():
+        if proc.poll() is None:
+            proc.kill()
+        proc.communicate()
 
 
 @pytest.fixture(scope="module")
-def roslaunch_dumps(_roslaunch_resolving) -> dict:
-    """--nodes/--dump-params/--files/--args of every demo, from real roslaunch (one process)."""
-    out, err = _roslaunch_resolving.communicate(timeout=60)
-    assert _roslaunch_resolving.returncode == 0, err
-    return json.loads(out)
-
-
-def _orchestra_dumps(words: str, nodes: list[str]) -> dict:
-    """The same four answers from ``orchestra launch``, its processes run concurrently."""
-    env = dict(os.environ, **DUMP_ENV)
-    runs = {option: [sys.executable, "-m", "orchestra", "launch", *option.split(),
-                     *words.split()]
-            for option in ["--nodes", "--dump-params", "--files",
-                           *(f"--args {node}" for node in nodes)]}
-    procs = {option: subprocess.Popen(argv, env=env, stdout=subprocess.PIPE,
-                                      stderr=subprocess.PIPE, text=True)
-             for option, argv in runs.items()}
-    outputs = {}
-    for option, proc in procs.items():
-        out, err = proc.communicate(timeout=30)
-        outputs[option] = out if proc.returncode == 0 else {"error": err}
-    return outputs
+def dumps(_resolving) -> dict:
+    """{"roslaunch"|"orchestra": {demo: {"nodes", "params", "files", "args": {node: text}}}}."""
+    answers = {}
+    for name, proc in _resolving.items():
+        out, err = proc.communicate(timeout=60)
+        assert proc.returncode == 0, err
+        answers[name] = json.loads(out)
+    return answers
 
 
 @pytest.mark.timeout(90)
 @pytest.mark.parametrize("demo", DEMOS)
-def test_real_roslaunch_resolves_bundled_demo_to_the_same_nodes_params_and_argv(
-        roslaunch_dumps, demo):
-    real = roslaunch_dumps[demo]
+def test_real_roslaunch_resolves_bundled_demo_to_the_same_nodes_params_and_argv(dumps, demo):
+    real, ours = dumps["roslaunch"][demo], dumps["orchestra"][demo]
     assert isinstance(real["nodes"], str), real["nodes"]
-    ours = _orchestra_dumps(demo, real["nodes"].split())
-    assert ours["--nodes"] == real["nodes"]
-    assert yaml.safe_load(ours["--dump-params"]) == yaml.safe_load(real["params"])
+    assert ours["nodes"] == real["nodes"]
+    assert yaml.safe_load(ours["params"]) == yaml.safe_load(real["params"])
     # roslaunch prints the files read from a set (any order); orchestra in reading order
-    assert sorted(ours["--files"].split()) == sorted(real["files"].split())
+    assert sorted(ours["files"].split()) == sorted(real["files"].split())
     # roslaunch writes env prefixes as K="v", orchestra shell-quotes only when needed
     # (K=v): compared as the words a shell makes of them, which is what `| bash` runs
+    assert set(ours["args"]) == set(real["args"])
     for node, argv in real["args"].items():
-        assert shlex.split(ours[f"--args {node}"]) == shlex.split(argv), node
+        assert shlex.split(ours["args"][node]) == shlex.split(argv), node
