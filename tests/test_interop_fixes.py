@@ -126,3 +126,19 @@ def test_kill_of_a_node_that_no_longer_answers_names_it(master):
     proxy.registerPublisher("/ghost", "/t", "std_msgs/String", dead_uri)
     with pytest.raises(introspect.GraphError, match=r"node \[/ghost\] does not answer"):
         introspect.kill_node(master.uri, "/ghost")
+
+
+def test_echo_noarr_names_the_array_type_and_length_as_rostopic_does():
+    from orchestra.node.cli import hide_arrays
+    from orchestra.node.msg import get_message_class, to_yaml_text
+
+    poses = get_message_class("geometry_msgs/PoseArray")()
+    poses.poses = [get_message_class("geometry_msgs/Pose")()] * 2
+    hide_arrays(poses)
+    assert to_yaml_text(poses).endswith(
+        '\nposes: "<array type: geometry_msgs/Pose, length: 2>"')
+    # rostopic strips the brackets character-wise: a fixed array keeps "[36"
+    pose = get_message_class("geometry_msgs/PoseWithCovariance")()
+    hide_arrays(pose)
+    assert pose.covariance == "<array type: float64[36, length: 36>"
+    assert pose.pose.position.x == 0.0  # nested messages are left alone (top level only)

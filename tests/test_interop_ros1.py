@@ -443,9 +443,9 @@ def test_real_rostopic_echo_prints_what_orchestra_topic_echo_prints(side):
 
     def without_seq(text: str) -> str:
         return "\n".join(line for line in text.splitlines() if "seq:" not in line)
-    results = side.run_all(*[(tool, verb, *(["echo"] if tool == "orchestra" else []), "-n", "1",
-                               topic) for topic in ("/poses", "/greeting")
-                             for tool, verb in (("rostopic", "echo"), ("orchestra", "topic"))])
+    echoes = [["/poses"], ["--noarr", "/poses"], ["/greeting"]]
+    results = side.run_all(*[(*tool, "-n", "1", *words) for words in echoes
+                             for tool in (("rostopic", "echo"), ("orchestra", "topic", "echo"))])
     for real, ours in zip(results[::2], results[1::2]):
         assert real.returncode == 0 and ours.returncode == 0, real.stderr + ours.stderr
         assert without_seq(ours.stdout) == without_seq(real.stdout)

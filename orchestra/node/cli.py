@@ -341,16 +341,24 @@ def topic_echo(name: str, count: int | None, noarr: bool) -> None:
             if fields:
                 msg = pick_field(msg, fields)
             if noarr and hasattr(msg, "_fields"):
-                for field_name in msg._fields:
-                    value = getattr(msg, field_name)
-                    if isinstance(value, (list, tuple, bytes)):
-                        setattr(msg, field_name, f"<array of length {len(value)}>")
+                hide_arrays(msg)
             click.echo(to_yaml_text(msg) + "\n---")
             printed += 1
     except KeyboardInterrupt:
         pass
     finally:
         _stop_cli_node("topic echo done")
+
+
+def hide_arrays(msg) -> None:
+    """``--noarr``: each array field of ``msg`` (top level only) becomes rostopic's
+    ``<array type: T, length: N>`` text; T is the field type with its trailing brackets
+    stripped as rostopic strips them (``float64[3]`` gives ``float64[3``)."""
+    for field_name, slot_type in zip(msg._fields, msg._slot_types):
+        if "[" in slot_type:
+            length = len(getattr(msg, field_name))
+            setattr(msg, field_name,
+                    f"<array type: {slot_type.rstrip('[]')}, length: {length}>")
 
 
 def split_field_path(name: str, topics: list[str]) -> tuple[str, list[str]]:
