@@ -26,8 +26,9 @@ class _RospyLikeSlave:
     serving).
     """
 
-    def __init__(self, reply: str):
+    def __init__(self, reply: str, answers: dict | None = None):
         self.reply = reply
+        self.answers = {"getPid": 4242, **(answers or {})}
         self.done = False
         owner = self
 
@@ -44,7 +45,8 @@ class _RospyLikeSlave:
                 if method == "shutdown":
                     data = xmlrpc.client.dumps(([-1, "not now", 0],), methodresponse=True)
                 else:
-                    data = xmlrpc.client.dumps(([1, "", 4242],), methodresponse=True)
+                    data = xmlrpc.client.dumps(([1, "", owner.answers[method]],),
+                                               methodresponse=True)
                 self.send_response(200)
                 self.send_header("Content-Type", "text/xml")
                 self.send_header("Content-Length", str(len(data)))
@@ -142,3 +144,38 @@ def test_echo_noarr_names_the_array_type_and_length_as_rostopic_does():
     hide_arrays(pose)
     assert pose.covariance == "<array type: float64[36, length: 36>"
     assert pose.pose.position.x == 0.0  # nested messages are left alone (top level only)
+
+
+def test_node_info_names_inbound_peers_and_shows_rospy_socket_text_like_rosnode(
+        master, monkeypatch, capsys):
+    from orchestra.cli import main
+
+    publisher = _RospyLikeSlave("drop")
+    listener = _RospyLikeSlave("drop", {"getBusInfo": [
+        [1, publisher.uri, "i", "TCPROS", "/t", True,
+         "TCPROS connection on port 4000 to [127.0.0.1:5000 on socket 9]"],
+        [2, "/gone", "i", "TCPROS", "/t", False, ""],
+        [3, "/late", "o", "TCPROS", "/t", True]]})
+    try:
+        proxy = xmlrpc.client.ServerProxy(master.uri)
+        proxy.registerPublisher("/talker", "/t", "std_msgs/String", publisher.uri)
+        proxy.registerSubscriber("/listener", "/t", "std_msgs/String", listener.uri)
+        monkeypatch.setenv("ROS_MASTER_URI", master.uri)
+        with pytest.raises(SystemExit) as info:
+            main(["node", "info", "/listener"])
+        assert info.value.code == 0
+        out = capsys.readouterr().out
+        assert out.endswith(
+            "Pid: 4242\nConnections:\n"
+            " * topic: /t\n"
+            f"    * to: /talker ({publisher.uri})\n"
+            "    * direction: inbound (4000 - 127.0.0.1:5000) [9]\n"
+            "    * transport: TCPROS\n"
+            " * topic: /t\n"
+            "    * to: /late\n"
+            "    * direction: outbound\n"
+            "    * transport: TCPROS\n"
+            "\n")
+    finally:
+        publisher.close()
+        listener.close()

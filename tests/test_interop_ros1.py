@@ -531,6 +531,23 @@ def test_real_rosnode_lists_inspects_and_kills_orchestra_nodes(side):
     assert "/talker" not in side.tool("rosnode", "list").stdout.split()
 
 
+def test_orchestra_node_info_prints_what_real_rosnode_info_prints(real_side):
+    side = real_side
+    side.rospy("--name", "talker", "pub", "chatter", "std_msgs/String", "data: x").ready()
+    side.orch("--name", "ours", "sub", "chatter", "std_msgs/String").expect(
+        lambda d: "msg" in d)
+    side.rospy("--name", "theirs", "sub", "chatter", "std_msgs/String").expect(
+        lambda d: "msg" in d)
+    names = ("/talker", "/ours", "/theirs")
+    results = side.run_all(*[cmd for name in names for cmd in
+                             (("rosnode", "info", name), ("orchestra", "node", "info", name))])
+    for name, real, ours in zip(names, results[::2], results[1::2]):
+        assert real.returncode == ours.returncode == 0, real.stderr + ours.stderr
+        assert ours.stdout == real.stdout, name
+    # inbound connections name the publisher as rosnode does: "/node (uri)"
+    assert "    * to: /talker (http://" in results[3].stdout
+
+
 def test_orchestra_tools_work_against_a_real_rosmaster_and_rospy_nodes(real_side, tmp_path):
     side = real_side
     talker = side.rospy("--name", "talker", "pub", "chatter", "geometry_msgs/Twist",

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import queue
+import re
 import time
 
 import click
@@ -140,11 +141,40 @@ def node_info(name: str) -> None:
     click.echo(f"Pid: {pid}")
     if info:
         click.echo("Connections:")
-        for _cid, dest, direction, transport, topic, _connected, *_ in info:
+        node_uris: dict[str, str | None] = {}
+        for row in info:
+            _cid, dest, direction, transport, topic = row[:5]
+            if len(row) > 5 and not row[5]:
+                continue  # rosnode lists live connections only
             click.echo(f" * topic: {topic}")
-            click.echo(f"    * to: {dest}")
-            click.echo(f"    * direction: {'outbound' if direction == 'o' else 'inbound'}")
+            click.echo(f"    * to: {_peer(uri_master, state, topic, dest, node_uris)}")
+            way = {"o": "outbound", "i": "inbound"}.get(direction, "unknown")
+            # rospy and roscpp describe the socket in a 7th field; rosnode shows it too
+            socket_info = CONNECTION_TEXT.match(row[6]) if len(row) > 6 else None
+            if socket_info:
+                way += " (%s - %s) [%s]" % socket_info.groups()
+            click.echo(f"    * direction: {way}")
             click.echo(f"    * transport: {transport}")
+    click.echo("")  # rosnode prints the whole block, then a blank line
+
+
+# "TCPROS connection on port 36527 to [127.0.0.1:43264 on socket 8]"
+CONNECTION_TEXT = re.compile(r"\w+ connection on port (\d+) to \[(.*) on socket (\d+)\]")
+
+
+def _peer(master_uri: str, state, topic: str, dest: str, cache: dict) -> str:
+    """rosnode's name for a connection's far end: an inbound connection reports the
+    publisher's slave URI, shown as ``/node (uri)`` when a node on the topic has that URI;
+    anything else (an outbound connection reports the subscriber's name) as it is."""
+    for node in (*state.publishers.get(topic, ()), *state.subscribers.get(topic, ())):
+        if node not in cache:
+            try:
+                cache[node] = introspect.lookup_node(master_uri, node)
+            except OrchestraError:
+                cache[node] = None
+        if cache[node] == dest:
+            return f"{node} ({dest})"
+    return dest
 
 
 @node.command("kill")
