@@ -244,23 +244,32 @@ def topic() -> None:
 
 
 @topic.command("list")
+@click.argument("namespace", required=False)
 @click.option("-v", "--verbose", is_flag=True, help="Group by publishers and subscribers.")
-def topic_list(verbose: bool) -> None:
-    """Print every topic with a publisher or a subscriber."""
+def topic_list(namespace: str | None, verbose: bool) -> None:
+    """Print every topic with a publisher or a subscriber (in NAMESPACE, if given)."""
     state = introspect.system_state(_master_uri())
+    within = _in_namespace(_global(namespace)) if namespace else (lambda t: True)
     if not verbose:
         for t in state.topics:
-            click.echo(t)
+            if within(t):
+                click.echo(t)
         return
     for title, table in (("Published topics", state.publishers),
                          ("Subscribed topics", state.subscribers)):
         click.echo(f"\n{title}:")
-        for t in sorted(table):
+        for t in sorted(filter(within, table)):
             n = len(table[t])
             click.echo(f" * {t} [{state.types.get(t, 'unknown type')}] {n} "
                        f"{'publisher' if title.startswith('Pub') else 'subscriber'}"
                        f"{'s' if n != 1 else ''}")
     click.echo("")
+
+
+def _in_namespace(name: str):
+    """rostopic list's filter: the name itself, or anything under ``name/``."""
+    prefix = name.rstrip("/") + "/"
+    return lambda topic: topic == name or topic.startswith(prefix)
 
 
 @topic.command("type")
@@ -308,6 +317,7 @@ def topic_info(name: str) -> None:
                 api = "unknown address"
             click.echo(f" * {n} ({api})")
         click.echo("")
+    click.echo("")  # rostopic prints the whole text, then a blank line
 
 
 class _Decoder:
@@ -621,9 +631,8 @@ def service_call(name: str, values: tuple[str, ...]) -> None:
     if not ok:
         raise CommandFailed(f"service [{name}] responded with an error: "
                             f"{body.decode('utf-8', 'replace')}")
-    text = to_yaml_text(cls._response_class.deserialize_bytes(body))
-    if text:
-        click.echo(text)
+    # an empty response prints an empty line, as rosservice does
+    click.echo(to_yaml_text(cls._response_class.deserialize_bytes(body)))
 
 
 # --- graph -------------------------------------------------------------------------------------
