@@ -277,7 +277,8 @@ class Launcher:
                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                                      start_new_session=True)
         self.ps = psutil.Process(self.proc.pid)
-        self.seen: dict[int, psutil.Process] = {}
+        self.seen: dict[int, psutil.Process] = {}    # node processes
+        self.others: list[psutil.Process] = []       # master, rosout: orphans once it is killed
 
     def wait_running(self, n: int, limit: float = 60.0) -> float:
         """Seconds from Popen until ``n`` node processes run (raises past ``limit``)."""
@@ -315,7 +316,7 @@ class Launcher:
 
     def kill(self) -> None:
         """SIGKILL whatever this run started that still runs (launcher, master, nodes)."""
-        procs = self.everything() + list(self.seen.values())
+        procs = self.everything() + list(self.seen.values()) + self.others
         ros1.kill_tree(self.proc.pid)
         for proc in alive(procs):
             try:
@@ -368,12 +369,12 @@ def real_roslaunch_comparison(n: int, quick: bool) -> list:
             try:
                 run.wait_running(n)
                 time.sleep(1.0)
-                others = [p for p in run.everything() if p.pid not in run.seen]
+                run.others = [p for p in run.everything() if p.pid not in run.seen]
                 os.kill(run.proc.pid, signal.SIGKILL)
                 run.proc.wait(10)
                 time.sleep(2.0)
                 orphans = len(alive(list(run.seen.values())))
-                other_left = len(alive(others))
+                other_left = len(alive(run.others))
                 rows.append([f"launcher SIGKILLed: nodes still running after 2 s (of {n})", kind,
                              orphans, f"+{other_left} master/rosout processes"])
             finally:
