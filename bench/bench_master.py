@@ -162,7 +162,7 @@ def main() -> None:
     real: list[RealRosmaster] = []
     try:
         if ros1.tool("rosmaster") is None:
-            ros1.skip("the real rosmaster", "/usr/bin/rosmaster")
+            ros1.skip("the real rosmaster", "rosmaster (ROS 1)")
         else:
             real = [RealRosmaster(), RealRosmaster()]
         p_std = xmlrpc.client.ServerProxy(f"http://127.0.0.1:{stdlib.server_address[1]}/")

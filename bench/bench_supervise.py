@@ -409,7 +409,7 @@ def main() -> None:
     real_rows = []
     if ros1.tool("roslaunch") is None:
         if not args.json:
-            ros1.skip("the real roslaunch comparison", "/usr/bin/roslaunch")
+            ros1.skip("the real roslaunch comparison", "roslaunch (ROS 1)")
     else:
         real_rows = real_roslaunch_comparison(args.nodes, args.quick)
     if args.json:
