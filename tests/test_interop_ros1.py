@@ -43,7 +43,7 @@ def _real_ros_missing() -> str | None:
                            text=True, env=_ros_env({}))
     if probe.returncode != 0:
         return ("Debian's ROS 1 (python3-rospy, python3-rosmaster) is not installed for "
-                f"{ROS_PYTHON}: {probe.stderr.strip().splitlines()[-1:]}")
+                f"{ROS_PYTHON}: {(probe.stderr.strip().splitlines() or ['?'])[-1]}")
     return None
 
 
