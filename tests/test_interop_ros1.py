@@ -287,16 +287,19 @@ def test_orchestra_subscriber_connects_when_a_rospy_publisher_starts_later(side)
     assert listener.expect(lambda d: "msg" in d)["callerid"] == "/talker"
 
 
-def test_rospy_cached_param_follows_orchestra_param_set(side, master):
-    master.params.set("/interop/gain", 1)
+def test_rospy_cached_param_follows_orchestra_param_set_and_delete(side, master):
+    # subscribed before it exists: the set still reaches rospy's cache
     watcher = side.rospy("--name", "watcher", "watch", "/interop/gain")
-    assert watcher.ready()["value"] == 1
+    assert watcher.ready()["value"] is None
     result = side.orchestra("param", "set", "/interop/gain", "7")
     assert result.returncode == 0, result.stderr
     assert watcher.expect(lambda d: d.get("value") == 7, timeout=5)
     result = side.orchestra("param", "set", "/interop", "{gain: 8, other: x}")
     assert result.returncode == 0, result.stderr
     assert watcher.expect(lambda d: d.get("value") == 8, timeout=5)
+    result = side.orchestra("param", "delete", "/interop")
+    assert result.returncode == 0, result.stderr
+    assert watcher.expect(lambda d: "value" in d and d["value"] is None, timeout=5)
 
 
 # --- 2. topics both ways --------------------------------------------------------------------

@@ -161,7 +161,7 @@ def run_params():
 def run_watch(key):
     rospy.init_node(opts.name, anonymous=opts.anonymous)
     last = object()
-    emit(ready=rospy.get_name(), value=rospy.get_param_cached(key))
+    emit(ready=rospy.get_name(), value=rospy.get_param_cached(key, None))
     while not rospy.is_shutdown():
         value = rospy.get_param_cached(key, None)
         if value != last:
