@@ -45,8 +45,9 @@ PARAMS_PER_NODE = 20
 # Runs inside the ROS 1 interpreter: each job is loaded once to warm up (imports), then
 # ``rounds`` more times, keeping the best. With "roscore" it is what `roslaunch` does
 # (load_config_default: roscore.xml first, whose /rosversion and /rosdistro params run
-# `rosversion` twice); without, only the launch file itself. roslaunch reads ``name:=value`` words from sys.argv, and $(env)/$(find)
-# from os.environ, so both are set per case as `roslaunch` itself would see them.
+# `rosversion` twice); without, only the launch file itself (what `roslaunch --dump-params`
+# does). roslaunch reads ``name:=value`` words from sys.argv, and $(env)/$(find) from
+# os.environ, so both are set per case as `roslaunch` itself would see them.
 ROSLAUNCH_IN_PROCESS = """
 import logging, os, sys, time
 logging.disable(logging.CRITICAL)
@@ -157,8 +158,8 @@ def bench_cases(samples: int, rounds: int, rows: list) -> None:
                for path, words, env in jobs[:samples]]
     sub = statistics.median(per_sub)
     per_case = in_process / len(jobs)
-    print(f"compat cases (--no-exec): {len(jobs)} resolved in-process in {in_process * 1000:.0f} ms "
-          f"({per_case * 1000:.2f} ms/case)")
+    print(f"compat cases (--no-exec): {len(jobs)} resolved in-process in "
+          f"{in_process * 1000:.0f} ms ({per_case * 1000:.2f} ms/case)")
     print(f"orchestra CLI subprocess: median {sub * 1000:.0f} ms/case over {len(per_sub)} cases "
           f"-> in-process is {sub / per_case:.0f}x cheaper per case")
 
@@ -172,8 +173,9 @@ def bench_cases(samples: int, rounds: int, rows: list) -> None:
     both = [i for i in range(len(jobs)) if o_times[i] is not None and r_times[i] is not None]
     r_fail = [i for i in range(len(jobs)) if r_times[i] is None]
     o_fail = [i for i in range(len(jobs)) if o_times[i] is None]
+    example = " ".join((r_errors[r_fail[0]] or "").split())[-160:] if r_fail else "-"
     print(f"real roslaunch cannot load {len(r_fail)} of {len(jobs)} cases here "
-          f"(skipped on both sides), e.g. {' '.join((r_errors[r_fail[0]] or '').split())[-160:] if r_fail else '-'}")
+          f"(skipped on both sides), e.g. {example}")
     only_o = sorted(set(o_fail) - set(r_fail))
     if only_o:
         print(f"orchestra failed {len(only_o)} cases real roslaunch loads: "

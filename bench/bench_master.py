@@ -214,7 +214,8 @@ def main() -> None:
           f"({n / register_s:.0f}/s)")
     if real:
         ours_by_name = dict(zip([name for name, _ in cases], best))
-        print(f"\n{'same client, calls/s':<{width}}  {'orchestra':>9}  {'rosmaster':>9}  {'ratio':>6}")
+        print(f"\n{'same client, calls/s':<{width}}  {'orchestra':>9}  {'rosmaster':>9}  "
+              f"{'ratio':>6}")
         for (name, _), value in zip(theirs, best_real):
             mine = ours_by_name[name]
             print(f"{name:<{width}}  {mine:9.0f}  {value:9.0f}  {mine / value:5.1f}x")

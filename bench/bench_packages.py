@@ -156,7 +156,8 @@ def find_heavy_launch(directory: str, names: list[str]) -> str:
     with open(path, "w") as fh:
         fh.write("<launch>\n")
         for i in range(FINDS):
-            fh.write(f'  <param name="find/p{i:04d}" value="$(find {names[i % len(names)]})/launch"/>\n')
+            name = names[i % len(names)]
+            fh.write(f'  <param name="find/p{i:04d}" value="$(find {name})/launch"/>\n')
         fh.write("</launch>\n")
     return path
 
