@@ -519,8 +519,8 @@ def test_real_rosservice_lists_and_calls_orchestra_services(side):
 
 def test_real_rosnode_lists_inspects_and_kills_orchestra_nodes(side):
     talker = side.orch("--name", "talker", "pub", "chatter", "std_msgs/String", "data: x")
-    side.orch("--name", "listener", "sub", "chatter", "std_msgs/String").expect(
-        lambda d: "msg" in d)
+    listener = side.orch("--name", "listener", "sub", "chatter", "std_msgs/String")
+    listener.expect(lambda d: "msg" in d)
     talker.ready()
     listed, info = side.run_all(("rosnode", "list"), ("rosnode", "info", "/talker"))
     assert {"/talker", "/listener"} <= set(listed.stdout.split()), listed
@@ -532,6 +532,13 @@ def test_real_rosnode_lists_inspects_and_kills_orchestra_nodes(side):
     assert kill.returncode == 0, kill.stderr
     assert talker.wait(10) == 0
     assert "/talker" not in side.tool("rosnode", "list").stdout.split()
+    # a node that died without unregistering: rosnode cleanup purges it from our master
+    listener.signal(signal.SIGKILL)
+    listener.wait(5)
+    cleanup = subprocess.run([ROS_PYTHON, "/usr/bin/rosnode", "cleanup"], input="y\n",
+                             env=side.ros_env, capture_output=True, text=True, timeout=20)
+    assert cleanup.returncode == 0 and "Unregistering /listener" in cleanup.stdout, cleanup
+    assert side.master().getSystemState("/probe")[2] == [[], [], []]
 
 
 def test_orchestra_node_info_prints_what_real_rosnode_info_prints(real_side):
