@@ -740,6 +740,11 @@ def test_real_roslaunch_runs_a_launch_file_against_orchestra_core(tmp_path):
         # roslaunch found orchestra core's /run_id and registered its own server node
         run_id = master.getParam("/probe", "/run_id")[2]
         assert run_id in log.read_text()
+        # orchestra's /rosout collects the rospy node's log messages
+        rosout_log = tmp_path / "ros_home" / "log" / run_id / "rosout.log"
+        wait_for(lambda: rosout_log.exists() and " INFO /robot/reporter [" in
+                 rosout_log.read_text(), timeout=10)
+        assert f"report written to {out}" in rosout_log.read_text()
         assert _stop(roslaunch) == 0, log.read_text()[-2000:]
         pubs = master.getSystemState("/probe")[2][0]
         assert not [t for t, nodes in pubs if "/robot/reporter" in nodes]

@@ -2,8 +2,9 @@
 """A real rospy node that reports what its launcher gave it: report.py OUT_FILE.
 
 Writes one JSON object to OUT_FILE (name, namespace, ROS_NAMESPACE, how 'chatter' resolves,
-its private params, the topics the master lists for it, its argv without remaps), then spins
-until shut down. Run by both roslaunch and orchestra launch, the two reports must agree.
+its private params, the topics the master lists for it, its argv without remaps), then logs
+a line five times a second until shut down. Run by both roslaunch and orchestra launch,
+the two reports must agree.
 """
 import json
 import os
@@ -33,4 +34,12 @@ out = rospy.myargv(sys.argv)[1]
 with open(out + ".tmp", "w") as stream:
     json.dump(report, stream)
 os.rename(out + ".tmp", out)
-rospy.spin()
+# log until shut down: whoever runs /rosout (roscore's or orchestra's) must collect it;
+# repeated because rospy drops log messages sent before /rosout has connected
+rate = rospy.Rate(5)
+while not rospy.is_shutdown():
+    rospy.loginfo("report written to %s", out)
+    try:
+        rate.sleep()
+    except rospy.ROSInterruptException:
+        break
