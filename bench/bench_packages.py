@@ -164,7 +164,7 @@ def find_heavy_launch(directory: str, names: list[str]) -> str:
 
 def bench_ros1(label: str, root: str, repeat: int, results: dict, rows: list) -> None:
     """The real roslaunch and rospack on ``root`` next to orchestra, whole processes."""
-    roslaunch, rospack = ros1.tool("roslaunch"), ros1.which_rospack()
+    roslaunch, rospack = ros1.tool("roslaunch"), ros1.tool("rospack")
     names = sorted(PackageIndex.build([root], cache_dir=None).packages)
     if ros1.has_modules("rospkg"):
         # only packages real ROS 1 finds: rospkg/rospack leave metapackages out (orchestra

@@ -13,7 +13,6 @@ from __future__ import annotations
 import functools
 import json
 import os
-import shutil
 import signal
 import subprocess
 import tempfile
@@ -105,7 +104,3 @@ def kill_tree(pid: int, sig: int = signal.SIGKILL) -> None:
             proc.send_signal(sig)
         except psutil.NoSuchProcess:
             pass
-
-
-def which_rospack() -> str | None:
-    return tool("rospack") or shutil.which("rospack", path=ROS1_BIN)
