@@ -10,9 +10,11 @@ because this module is imported by the orchestra-side interpreter and must not i
 """
 from __future__ import annotations
 
+import atexit
 import functools
 import json
 import os
+import shutil
 import signal
 import subprocess
 import tempfile
@@ -57,7 +59,10 @@ def base_env(**extra: str) -> dict[str, str]:
 
 @functools.lru_cache(maxsize=None)
 def _ros_home() -> str:
-    return tempfile.mkdtemp(prefix="orchestra-bench-ros1-home-")
+    """One private ROS_HOME per bench run, removed when the run ends."""
+    path = tempfile.mkdtemp(prefix="orchestra-bench-ros1-home-")
+    atexit.register(shutil.rmtree, path, ignore_errors=True)
+    return path
 
 
 def run_ros1_code(code: str, payload: object, env: dict[str, str] | None = None,
