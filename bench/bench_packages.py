@@ -167,8 +167,8 @@ def bench_ros1(label: str, root: str, repeat: int, results: dict, rows: list) ->
     roslaunch, rospack = ros1.tool("roslaunch"), ros1.tool("rospack")
     names = sorted(PackageIndex.build([root], cache_dir=None).packages)
     if ros1.has_modules("rospkg"):
-        # only packages real ROS 1 finds: rospkg/rospack leave metapackages out (orchestra
-        # finds them), and one unknown $(find) would make roslaunch reject the whole file
+        # only packages real ROS 1 finds (both leave metapackages out; ROS 1 also has
+        # /usr/share): one unknown $(find) would make roslaunch reject the whole file
         theirs = set(ros1.run_ros1_code("import rospkg\nRESULT = rospkg.RosPack().list()", None,
                                         env=ros1.base_env(ROS_PACKAGE_PATH=root)))
         if set(names) - theirs:

@@ -147,8 +147,31 @@ def test_ros_package_path_shadows_bundled_package(monkeypatch, tmp_path):
 
 def test_compat_workspace_has_all_118_packages(compat_dir, tmp_path):
     index = PackageIndex.build([str(compat_dir / "ws")], cache_dir=str(tmp_path))
-    assert len(index.packages) == 118
+    # like rospack, the 16 metapackages among them are not findable packages
+    assert len(index.packages) + len(index.metapackages) == 118
+    assert len(index.metapackages) == 16
     assert index.find("turtlesim") == str(compat_dir / "ws" / "turtlesim")
+
+
+def test_metapackage_is_not_found_like_rospack_and_the_error_says_why(tmp_path):
+    root = tmp_path / "root"
+    make_pkg(root / "real_pkg")
+    meta = root / "meta_pkg"
+    meta.mkdir(parents=True)
+    (meta / "package.xml").write_text(
+        '<package format="2"><name>meta_pkg</name><version>1.0.0</version>'
+        "<description>d</description><maintainer email='a@b.c'>a</maintainer>"
+        "<license>BSD</license><buildtool_depend>catkin</buildtool_depend>"
+        "<exec_depend>real_pkg</exec_depend><export><metapackage/></export></package>")
+    (meta / "inner").mkdir()
+    make_pkg(meta / "inner" / "hidden_pkg")  # a metapackage stops the descent like a package
+    index = PackageIndex.build([str(root)], cache_dir=str(tmp_path / "cache"))
+    assert "real_pkg" in index and "meta_pkg" not in index and "hidden_pkg" not in index
+    with pytest.raises(PackageNotFound, match="is a metapackage"):
+        index.find("meta_pkg")
+    # the warm cache keeps the distinction
+    warm = PackageIndex.build([str(root)], cache_dir=str(tmp_path / "cache"))
+    assert "meta_pkg" not in warm and warm.metapackages["meta_pkg"] == str(meta)
 
 
 # -- the disk cache -----------------------------------------------------------------------------

@@ -22,7 +22,7 @@ from orchestra.packages.crawl import Record
 
 log = logging.getLogger(__name__)
 
-FORMAT = 1
+FORMAT = 2  # 2: package records carry is_metapackage
 
 #: one file per root ever crawled would grow without bound (every test's temporary tree);
 #: past MAX_FILES the least recently written files go, down to KEEP_FILES

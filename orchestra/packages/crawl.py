@@ -12,8 +12,13 @@ a package, skip re-reading its manifest unless the manifest's own mtime changed)
 crawl therefore costs one ``stat`` per directory instead of a listing plus a manifest read.
 
 Records are plain lists so that they serialise to JSON unchanged:
-``[mtime_ns, "dir", [child, ...]]``, ``[mtime_ns, "pkg", name, manifest, manifest_mtime_ns]``
-or ``[mtime_ns, "stop"]`` (ignored, or no sub-directories to visit).
+``[mtime_ns, "dir", [child, ...]]``,
+``[mtime_ns, "pkg", name, manifest, manifest_mtime_ns, is_metapackage]`` or
+``[mtime_ns, "stop"]`` (ignored, or no sub-directories to visit).
+
+Metapackages (``<export><metapackage/></export>``) stop the descent like any package but are
+not packages to rospack: ``rospack find`` and roslaunch's ``$(find)`` do not resolve them.
+The crawl reports them separately so the index can say why such a name is not found.
 """
 from __future__ import annotations
 
@@ -39,14 +44,20 @@ Record = list
 
 _COMMENT = re.compile(rb"<!--.*?-->", re.S)
 _NAME = re.compile(rb"<name>\s*([^<]*?)\s*</name>")
+_METAPACKAGE = re.compile(rb"<export>.*?<metapackage\s*/?>.*?</export>", re.S)
 
 
 def manifest_name(directory: str, manifest: str) -> str:
-    """The name a package answers to: package.xml's ``<name>``, else the directory name.
+    """The name a package answers to: package.xml's ``<name>``, else the directory name."""
+    return read_manifest_head(directory, manifest)[0]
+
+
+def read_manifest_head(directory: str, manifest: str) -> tuple[str, bool]:
+    """(name, is_metapackage) of the package in ``directory``.
 
     This is deliberately a text scan, not a full parse: the crawl reads every manifest on the
-    path and only needs the name; full parsing (and its errors) happens when a command needs
-    the rest of the manifest.
+    path and only needs these two facts; full parsing (and its errors) happens when a command
+    needs the rest of the manifest.
     """
     if manifest == "package.xml":
         try:
@@ -54,11 +65,13 @@ def manifest_name(directory: str, manifest: str) -> str:
                 text = _COMMENT.sub(b"", fh.read())
         except OSError:
             text = b""
+        is_meta = _METAPACKAGE.search(text) is not None
         match = _NAME.search(text)
         if match and match.group(1):
-            return match.group(1).decode("utf-8", "replace")
+            return match.group(1).decode("utf-8", "replace"), is_meta
         log.warning("%s/package.xml has no <name>; using the directory name", directory)
-    return os.path.basename(directory)
+        return os.path.basename(directory), is_meta
+    return os.path.basename(directory), False
 
 
 @dataclass
@@ -66,6 +79,7 @@ class CrawlResult:
     """What a crawl of one root found, and the records a later crawl may reuse."""
 
     packages: list[tuple[str, str]] = field(default_factory=list)
+    metapackages: list[tuple[str, str]] = field(default_factory=list)
     records: dict[str, Record] = field(default_factory=dict)
     changed: bool = False
     listed: int = 0  # directories that had to be listed (0 when the cache was fully fresh)
@@ -90,7 +104,8 @@ def _scan(directory: str, mtime_ns: int, racy_after: int) -> Record:
                 manifest_mtime = -1
             if manifest_mtime >= racy_after:
                 manifest_mtime = -1
-            return [stored_mtime, "pkg", manifest_name(directory, manifest), manifest, manifest_mtime]
+            name, is_meta = read_manifest_head(directory, manifest)
+            return [stored_mtime, "pkg", name, manifest, manifest_mtime, is_meta]
     if NOSUBDIRS_MARKER in entries:
         return [stored_mtime, "stop"]
     children = []
@@ -146,7 +161,8 @@ def crawl(root: str, previous: dict[str, Record] | None = None) -> CrawlResult:
             result.changed = True
         result.records[directory] = record
         if record[1] == "pkg":
-            result.packages.append((record[2], directory))
+            found = result.metapackages if record[5] else result.packages
+            found.append((record[2], directory))
         elif record[1] == "dir":
             prefix = directory if directory.endswith(os.sep) else directory + os.sep
             stack.extend([prefix + child for child in reversed(record[2])])

@@ -32,10 +32,16 @@ _USE_DEFAULT = object()
 class PackageNotFound(OrchestraError):
     """A package name that no directory on the search path answers to."""
 
-    def __init__(self, name: str):
-        super().__init__(f"package '{name}' not found (searched ROS_PACKAGE_PATH, "
-                         "CMAKE_PREFIX_PATH, the current catkin workspace and orchestra's "
-                         "bundled packages)")
+    def __init__(self, name: str, metapackage_dir: str | None = None):
+        if metapackage_dir is not None:
+            message = (f"package '{name}' not found: {metapackage_dir} is a metapackage, and "
+                       "like rospack (and so roslaunch's $(find)) orchestra does not resolve "
+                       "metapackages; name one of the packages it groups instead")
+        else:
+            message = (f"package '{name}' not found (searched ROS_PACKAGE_PATH, "
+                       "CMAKE_PREFIX_PATH, the current catkin workspace and orchestra's "
+                       "bundled packages)")
+        super().__init__(message)
         self.name = name
 
 
@@ -50,6 +56,8 @@ class PackageIndex:
     origins: dict[str, SearchRoot] = field(default_factory=dict)
     #: directories that had to be listed while building (0 = everything came from the cache)
     listed: int = 0
+    #: metapackage name -> directory (first found): not packages to rospack, kept to explain
+    metapackages: dict[str, str] = field(default_factory=dict)
 
     @classmethod
     def build(cls, roots: list[str] | list[SearchRoot], cache_dir=_USE_DEFAULT) -> "PackageIndex":
@@ -73,13 +81,15 @@ class PackageIndex:
                     index.origins[name] = root
                 elif known != directory and directory not in index.duplicates.get(name, ()):
                     index.duplicates.setdefault(name, []).append(directory)
+            for name, directory in result.metapackages:
+                index.metapackages.setdefault(name, directory)
         return index
 
     def find(self, name: str) -> str:
         try:
             return self.packages[name]
         except KeyError:
-            raise PackageNotFound(name) from None
+            raise PackageNotFound(name, self.metapackages.get(name)) from None
 
     def __contains__(self, name: str) -> bool:
         return name in self.packages
