@@ -561,7 +561,9 @@ REAL_TOOL = {"topic": "rostopic", "service": "rosservice", "node": "rosnode", "p
 PARITY = [("topic", "list"), ("topic", "list", "/ns"), ("topic", "info", "/chatter"),
           ("topic", "info", "/ns/pose"), ("topic", "find", "geometry_msgs/Twist"),
           ("service", "list"), ("service", "info", "/set_bool"), ("service", "info", "/empty"),
-          ("service", "call", "/empty", "{}"), ("node", "list"), ("param", "list"),
+          ("service", "call", "/empty", "{}"),
+          # roscpp/GetLoggers from rospy: a response with an array of nested messages
+          ("service", "call", "/server/get_loggers"), ("node", "list"), ("param", "list"),
           ("param", "get", "/robot")]
 
 
