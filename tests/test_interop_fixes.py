@@ -179,3 +179,69 @@ def test_node_info_names_inbound_peers_and_shows_rospy_socket_text_like_rosnode(
     finally:
         publisher.close()
         listener.close()
+
+
+def test_a_signal_arriving_while_shutdown_starts_does_not_deadlock(monkeypatch):
+    """Found by killing nodes right as they exited: the SIGINT handler re-entered
+    signal_shutdown() on the thread that was inside it and waited for its own lock."""
+    from orchestra.node import runtime
+
+    rt = runtime.NodeRuntime("/n", "/", "http://127.0.0.1:9/", {}, "127.0.0.1", [])
+    started = []
+
+    class SignalDuringStart(threading.Thread):
+        def start(self):
+            rt.signal_shutdown("signal SIGINT")  # what the handler does, same thread
+            started.append(self)
+            super().start()
+
+    monkeypatch.setattr(runtime.threading, "Thread", SignalDuringStart)
+    caller = SignalDuringStart.__mro__[1](target=rt.signal_shutdown, args=("process exit",), daemon=True)
+    caller.start()
+    caller.join(5)
+    assert not caller.is_alive(), "signal_shutdown deadlocked"
+    assert len(started) == 1 and rt.is_shutdown()
+    rt.wait_shutdown_done(5)
+
+
+EXITING_NODE = """
+import json, sys, time
+import orchestra.node as rospy
+rospy.init_node("leaver")
+from orchestra.node.msg import get_message_class
+rospy.Publisher("chatter", get_message_class("std_msgs/String"))
+rospy.on_shutdown(lambda: time.sleep(1.0))   # a slow hook: the exit takes a while
+print(json.dumps({"ready": True}), flush=True)
+sys.stdin.readline()                          # the script ends when the test says so
+print(json.dumps({"ending": True}), flush=True)
+"""
+
+
+def test_sigint_while_a_finished_script_unregisters_does_not_leave_it_registered(
+        master, tmp_path):
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    script = tmp_path / "leaver.py"
+    script.write_text(EXITING_NODE)
+    env = dict(os.environ, ROS_MASTER_URI=master.uri, PYTHONUNBUFFERED="1")
+    proc = subprocess.Popen([sys.executable, str(script)], env=env, stdin=subprocess.PIPE,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert "ready" in proc.stdout.readline()
+        proc.stdin.write("\n")
+        proc.stdin.flush()
+        assert "ending" in proc.stdout.readline()
+        time.sleep(0.3)  # inside the slow hook, at interpreter exit
+        proc.send_signal(signal.SIGINT)
+        proc.send_signal(signal.SIGINT)
+        assert proc.wait(10) == 0, proc.stderr.read()
+        pubs = xmlrpc.client.ServerProxy(master.uri).getSystemState("/probe")[2][0]
+        assert not [t for t, nodes in pubs if "/leaver" in nodes]
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()

@@ -136,7 +136,10 @@ class NodeRuntime:
         self._shutdown_requested = threading.Event()
         self._shutdown_reason = ""
         self._cleanup: threading.Thread | None = None
-        self._cleanup_lock = threading.Lock()
+        # re-entrant: a signal handler runs on the main thread, possibly while that thread is
+        # inside signal_shutdown() (e.g. at process exit); it must find the cleanup under way
+        # instead of waiting for a lock its own thread holds
+        self._cleanup_lock = threading.RLock()
         self._hooks: list[Callable[..., Any]] = []
         self.params: dict[str, Any] = {}
 
@@ -255,11 +258,12 @@ class NodeRuntime:
                 return
             self._shutdown_reason = reason
             log.info("shutdown: %s", reason)
-            thread = threading.Thread(target=self._do_cleanup, name="node-shutdown",
-                                      daemon=False)
+            # recorded before start(): a re-entrant call (a signal arriving during start)
+            # returns instead of starting a second cleanup
+            self._cleanup = threading.Thread(target=self._do_cleanup, name="node-shutdown",
+                                             daemon=False)
             self._shutdown_requested.set()
-            thread.start()
-            self._cleanup = thread
+            self._cleanup.start()
 
     def wait_shutdown_done(self, timeout: float | None = 10.0) -> None:
         with self._cleanup_lock:
@@ -361,17 +365,24 @@ def init_node(name: str, argv: list[str] | None = None, anonymous: bool = False,
 _previous_handlers: dict[int, Any] = {}
 
 
+_exiting = False
+
+
 def _on_signal(signum, frame) -> None:
     """First signal: orderly shutdown (``is_shutdown()`` turns true, sleeps raise). A second
-    SIGINT goes to the previous handler (KeyboardInterrupt), for scripts that never look."""
+    SIGINT goes to the previous handler (KeyboardInterrupt), for scripts that never look;
+    not once the script has ended (``_exiting``): there a KeyboardInterrupt would only cut
+    the unregistration short and leave the node registered at the master."""
     already = is_shutdown()
     signal_shutdown(f"signal {signal.Signals(signum).name}")
     previous = _previous_handlers.get(signum)
-    if already and signum == signal.SIGINT and callable(previous):
+    if already and signum == signal.SIGINT and callable(previous) and not _exiting:
         previous(signum, frame)
 
 
 def _at_exit() -> None:
+    global _exiting
+    _exiting = True
     if _runtime is not None:
         _runtime.signal_shutdown("process exit")
         _runtime.wait_shutdown_done()
