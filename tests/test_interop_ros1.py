@@ -370,6 +370,10 @@ def test_md5_mismatch_is_refused_and_both_nodes_keep_working(side, direction):
     time.sleep(0.5)
     assert not [d for d in wrong.seen + _drain(wrong) if "msg" in d]
     assert pub.proc.poll() is None and wrong.proc.poll() is None
+    # orchestra's side says why, whichever end it is
+    ours = wrong if direction == "rospy_to_orchestra" else pub
+    wait_for(lambda: any("refused" in line and "geometry_msgs/Twist" in line
+                         for line in ours.stderr_lines), timeout=5)
     # the refused subscriber's node still answers its slave API
     _, _, uri = side.master().lookupNode("/probe", "/wrong")
     assert xmlrpc.client.ServerProxy(uri).getPid("/probe")[0] == 1
