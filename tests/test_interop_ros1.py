@@ -498,6 +498,16 @@ def test_orchestra_param_get_and_dump_print_what_real_rosparam_prints(side, mast
         assert ours.stdout == real.stdout.replace('"h\\xE9llo"', "h\u00e9llo"), ours.args
     assert (tmp_path / "ours.yaml").read_text() == (tmp_path / "real.yaml").read_text()
     assert yaml.safe_load(results[0].stdout) == yaml.safe_load(results[1].stdout)
+    # loading: rosparam's YAML tags (!degrees, !radians, !!binary) give the same values
+    source = tmp_path / "load.yaml"
+    source.write_text("angle: !degrees 180\nrad: !radians pi/2\nbin: !!binary aGVsbG8=\n"
+                      "nested: {a: 1, b: [x, {c: 2}]}\nflt: 1e3\nstr_num: '007'\n"
+                      "empty: []\n")
+    for loaded in side.run_all(("rosparam", "load", str(source), "/by_real"),
+                               ("orchestra", "param", "load", str(source), "/by_ours")):
+        assert loaded.returncode == 0, loaded.stderr
+    assert master.params.get("/by_ours") == master.params.get("/by_real")
+    assert master.params.get("/by_ours/angle") == pytest.approx(3.141592653589793)
 
 
 def test_real_rosservice_lists_and_calls_orchestra_services(side):
