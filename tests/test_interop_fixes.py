@@ -245,3 +245,20 @@ def test_sigint_while_a_finished_script_unregisters_does_not_leave_it_registered
         if proc.poll() is None:
             proc.kill()
             proc.wait()
+
+
+def test_bus_info_describes_the_socket_as_rospy_does():
+    from orchestra.node.topics import describe_socket
+
+    with socket.create_server(("127.0.0.1", 0)) as server:
+        client = socket.create_connection(server.getsockname())
+        accepted, _ = server.accept()
+        try:
+            port, peer = accepted.getsockname()[1], client.getsockname()
+            assert describe_socket(accepted) == (
+                f"TCPROS connection on port {port} to [{peer[0]}:{peer[1]} on socket "
+                f"{accepted.fileno()}]")
+        finally:
+            client.close()
+            accepted.close()
+    assert describe_socket(accepted) == "" and describe_socket(None) == ""

@@ -627,11 +627,27 @@ class TopicManager:
         with self.lock:
             for topic, pub in self.publications.items():
                 for c in list(pub.connections):
-                    info.append([c.id, c.peer, "o", "TCPROS", topic, True, ""])
+                    info.append([c.id, c.peer, "o", "TCPROS", topic, True,
+                                 describe_socket(c.sock)])
             for topic, sub in self.subscriptions.items():
                 for c in list(sub.connections.values()):
-                    info.append([c.id, c.uri, "i", "TCPROS", topic, c.connected, ""])
+                    info.append([c.id, c.uri, "i", "TCPROS", topic, c.connected,
+                                 describe_socket(c.sock)])
         return info
+
+
+def describe_socket(sock: socket.socket | None) -> str:
+    """The connection text rospy puts in getBusInfo's 7th field, which ``rosnode info``
+    shows as ``(local port - peer) [fd]``: "" when there is no open socket."""
+    if sock is None:
+        return ""
+    try:
+        port = sock.getsockname()[1]
+        host, peer_port = sock.getpeername()[:2]
+        fd = sock.fileno()
+    except OSError:
+        return ""
+    return f"TCPROS connection on port {port} to [{host}:{peer_port} on socket {fd}]"
 
 
 def xmlrpc_int(n: int) -> int | float:
