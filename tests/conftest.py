@@ -1,7 +1,6 @@
 """Shared fixtures: where ../shared is, and a clean environment for launch resolution."""
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import pytest
@@ -16,3 +15,39 @@ def compat_dir() -> Path:
     if not COMPAT.is_dir():
         pytest.skip("../shared/compat is not beside the repository")
     return COMPAT
+
+
+def _harness():
+    """tests/node_fixtures/harness.py, imported the way the node test modules import it."""
+    import sys
+
+    path = str(Path(__file__).resolve().parent / "node_fixtures")
+    if path not in sys.path:
+        sys.path.insert(0, path)
+    import harness
+
+    return harness
+
+
+@pytest.fixture
+def master():
+    """orchestra's master on a free loopback port (tests run beside others' on one machine)."""
+    from orchestra.master import start_master
+
+    handle = start_master(host="127.0.0.1", port=0)
+    yield handle
+    handle.shutdown()
+
+
+@pytest.fixture(scope="module")
+def package_path(tmp_path_factory) -> Path:
+    """A package path holding the node-runtime test package (tests/node_fixtures/harness.py)."""
+    return _harness().make_test_package(tmp_path_factory.mktemp("pkgs"))
+
+
+@pytest.fixture
+def nodes(master, package_path):
+    """Real node processes of the test package, talking through ``master``."""
+    group = _harness().Nodes(master.uri, package_path)
+    yield group
+    group.close()

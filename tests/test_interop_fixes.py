@@ -12,7 +12,6 @@ from xmlrpc.server import SimpleXMLRPCRequestHandler, SimpleXMLRPCServer
 
 import pytest
 
-from orchestra.master import start_master
 from orchestra.node import introspect
 
 pytestmark = pytest.mark.timeout(30)
@@ -76,13 +75,6 @@ class _RospyLikeSlave:
         except OSError:
             pass
         self.thread.join(2)
-
-
-@pytest.fixture
-def master():
-    handle = start_master(host="127.0.0.1", port=0)
-    yield handle
-    handle.shutdown()
 
 
 def _register(master, slave: _RospyLikeSlave) -> None:

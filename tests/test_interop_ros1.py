@@ -28,7 +28,6 @@ import yaml
 sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
 from harness import NodeProcess, wait_for  # noqa: E402
 
-from orchestra.master import start_master  # noqa: E402
 
 ROS_PYTHON = "/usr/bin/python3"
 HERE = Path(__file__).resolve().parent
@@ -142,13 +141,6 @@ class Side:
                 proc.proc.wait(max(0.1, deadline - time.monotonic()))
             except subprocess.TimeoutExpired:
                 proc.kill()
-
-
-@pytest.fixture
-def master():
-    handle = start_master(host="127.0.0.1", port=0)
-    yield handle
-    handle.shutdown()
 
 
 @pytest.fixture

@@ -53,13 +53,6 @@ class Slave:
 
 
 @pytest.fixture
-def master():
-    handle = start_master(port=0)
-    yield handle
-    handle.shutdown()
-
-
-@pytest.fixture
 def m(master):
     return xmlrpc.client.ServerProxy(master.uri)
 

@@ -11,31 +11,12 @@ from pathlib import Path
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
-from harness import Nodes, make_test_package, wait_for  # noqa: E402
+from harness import Nodes, wait_for  # noqa: E402
 
 from orchestra.master import start_master  # noqa: E402
 from orchestra.node import tcpros  # noqa: E402
 
 pytestmark = pytest.mark.timeout(60)
-
-
-@pytest.fixture(scope="module")
-def package_path(tmp_path_factory) -> Path:
-    return make_test_package(tmp_path_factory.mktemp("pkgs"))
-
-
-@pytest.fixture
-def master():
-    handle = start_master(host="127.0.0.1", port=0)
-    yield handle
-    handle.shutdown()
-
-
-@pytest.fixture
-def nodes(master, package_path):
-    group = Nodes(master.uri, package_path)
-    yield group
-    group.close()
 
 
 def system_state(master_uri: str):

@@ -12,20 +12,12 @@ from pathlib import Path
 
 import pytest
 
-from orchestra.master import start_master
 
 PACKAGES = Path(__file__).resolve().parent.parent / "packages"
 NODELET = str(PACKAGES / "nodelet" / "scripts" / "nodelet")
 MUX_YAML = str(PACKAGES / "yocs_cmd_vel_mux" / "param" / "example.yaml")
 
 pytestmark = pytest.mark.timeout(60)
-
-
-@pytest.fixture
-def master(tmp_path):
-    handle = start_master(host="127.0.0.1", port=0)
-    yield handle
-    handle.shutdown()
 
 
 @pytest.fixture

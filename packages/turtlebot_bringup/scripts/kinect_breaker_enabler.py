@@ -5,8 +5,6 @@ Waits for ``~service`` (default ``mobile_base/set_digital_outputs``, kobuki_msgs
 SetDigitalOutputs) up to ``~timeout`` seconds (default 30) and sets output ``~output``
 (default 1) on. Exits 1 when the base never offers the service or refuses.
 """
-import os
-import sys
 
 
 def main() -> int:
