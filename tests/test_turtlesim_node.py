@@ -3,6 +3,7 @@ a client process through the topic/service API against a master on a free port."
 from __future__ import annotations
 
 import json
+import shutil
 import os
 import signal
 import subprocess
@@ -141,3 +142,53 @@ def test_gui_requested_on_an_unusable_display_falls_back_to_headless(master):
     assert sim.returncode == 0
     assert "cannot open a window" in output and "running headless" in output
     assert "Traceback" not in output
+
+
+def _free_display() -> int:
+    """A display number no X server (or lock) uses yet."""
+    for number in range(170, 400):
+        if not os.path.exists(f"/tmp/.X{number}-lock") and \
+                not os.path.exists(f"/tmp/.X11-unix/X{number}"):
+            return number
+    pytest.skip("no free X display number")
+
+
+@pytest.mark.timeout(90)
+@pytest.mark.skipif(not (shutil.which("Xvfb") and shutil.which("xwd")),
+                    reason="Xvfb and xwd (Debian xvfb, x11-apps) are not installed")
+def test_gui_window_shows_the_canvas_on_a_real_x_server(master, tmp_path):
+    """On a desktop (DISPLAY set) turtlesim opens its Tk window: dump it and find the canvas."""
+    import time
+
+    display = f":{_free_display()}"
+    xvfb = subprocess.Popen(["Xvfb", display, "-screen", "0", "800x600x24", "-nolisten", "tcp"],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    env = dict(BUNDLED_ENV, ROS_MASTER_URI=master, DISPLAY=display, PYTHONUNBUFFERED="1")
+    sim = subprocess.Popen([str(SIM)], env=env, stdout=subprocess.PIPE,
+                           stderr=subprocess.STDOUT, text=True)
+    dump = tmp_path / "window.xwd"
+    try:
+        deadline = time.monotonic() + 40
+        while time.monotonic() < deadline:
+            grabbed = subprocess.run(["xwd", "-silent", "-name", "TurtleSim", "-out", str(dump)],
+                                     env=env, capture_output=True, timeout=20)
+            if grabbed.returncode == 0 and dump.stat().st_size > 500 * 500 * 3:
+                break
+            time.sleep(0.3)
+        else:
+            pytest.fail("no TurtleSim window appeared")
+        # 24/32-bit TrueColor dumps store pixels as B, G, R, pad: the default background
+        # (69, 86, 255) must fill most of the window
+        pixels = dump.read_bytes()
+        assert pixels.count(bytes((255, 86, 69))) > 200_000
+    finally:
+        sim.send_signal(signal.SIGINT)
+        try:
+            output, _ = sim.communicate(timeout=15)
+        except subprocess.TimeoutExpired:
+            sim.kill()
+            output, _ = sim.communicate()
+        xvfb.terminate()
+        xvfb.wait(timeout=10)
+    assert sim.returncode == 0, output
+    assert "running headless" not in output and "Traceback" not in output
