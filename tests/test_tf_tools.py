@@ -7,6 +7,7 @@ import importlib.util
 import math
 import os
 import re
+import shutil
 import signal
 import subprocess
 from pathlib import Path
@@ -134,6 +135,8 @@ def test_static_transform_reaches_tf_echo_and_view_frames(master, tmp_path):
         dot = (tmp_path / "frames.gv").read_text()
         assert '"odom" -> "base_link"' in dot and '"base_link" -> "laser" [label="static"]' in dot
         assert ">laser</text>" in (tmp_path / "frames.svg").read_text()
+        if shutil.which("dot"):  # like ROS's view_frames: frames.pdf through graphviz
+            assert (tmp_path / "frames.pdf").read_bytes().startswith(b"%PDF")
     finally:
         for p in procs:
             p.send_signal(signal.SIGINT)

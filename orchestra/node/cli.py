@@ -639,7 +639,8 @@ def service_call(name: str, values: tuple[str, ...]) -> None:
 
 @click.command()
 @click.option("-o", "--out", "out", type=click.Path(dir_okay=False), default=None,
-              help="Write to FILE (.svg or .dot); default: DOT on stdout.")
+              help="Write to FILE (.svg, .dot; .png or .pdf through graphviz); "
+                   "default: DOT on stdout.")
 @click.option("--all", "show_all", is_flag=True, help="Include /rosout.")
 def graph(out: str | None, show_all: bool) -> None:
     """Draw the running nodes and the topics between them."""
@@ -649,15 +650,18 @@ def graph(out: str | None, show_all: bool) -> None:
         click.echo(graphs.to_dot(g), nl=False)
         return
     lower = out.lower()
-    if lower.endswith(".dot") or lower.endswith(".gv"):
+    suffix = lower.rsplit(".", 1)[-1] if "." in lower else ""
+    if suffix in ("dot", "gv"):
         text = graphs.to_dot(g)
-    elif lower.endswith(".svg"):
+    elif suffix == "svg":
         text = graphs.to_svg(g)
-    elif lower.endswith(".png"):
-        raise OrchestraError("PNG output is not supported (no rasteriser without a new "
-                             "dependency): use --out graph.svg or graph.dot")
+    elif suffix in graphs.GRAPHVIZ_FORMATS:
+        graphs.render_with_graphviz(graphs.to_dot(g), suffix, out)
+        click.echo(f"wrote {out} ({g.number_of_nodes()} vertices, {g.number_of_edges()} "
+                   "edges)", err=True)
+        return
     else:
-        raise OrchestraError(f"unknown graph format for '{out}': use .svg or .dot")
+        raise OrchestraError(f"unknown graph format for '{out}': use .svg, .dot, .png or .pdf")
     try:
         with open(out, "w", encoding="utf-8") as fh:
             fh.write(text)

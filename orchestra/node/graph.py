@@ -122,3 +122,31 @@ def to_svg(graph: nx.DiGraph) -> str:
         out.append(f'<text x="{cx:.1f}" y="{cy + 4:.1f}" text-anchor="middle">{label}</text>')
     out.append("</g></svg>")
     return "\n".join(out) + "\n"
+
+
+#: formats graphviz's ``dot`` renders for us (a raster or PDF needs fonts and a rasteriser)
+GRAPHVIZ_FORMATS = ("png", "pdf")
+
+
+def render_with_graphviz(dot_text: str, fmt: str, out: str, dot: str = "dot") -> None:
+    """Render DOT text to ``out`` with graphviz's ``dot`` program, as rqt_graph users expect.
+
+    Raises OrchestraError when graphviz is not installed or ``dot`` fails, naming what to do.
+    """
+    import shutil
+    import subprocess
+
+    from orchestra.errors import OrchestraError
+
+    program = shutil.which(dot)
+    if program is None:
+        raise OrchestraError(f"{fmt.upper()} output needs graphviz's 'dot' program "
+                             "(e.g. apt install graphviz); or use --out graph.svg / graph.dot")
+    try:
+        result = subprocess.run([program, f"-T{fmt}", "-o", out], input=dot_text.encode(),
+                                capture_output=True, timeout=60)
+    except (OSError, subprocess.TimeoutExpired) as exc:
+        raise OrchestraError(f"graphviz 'dot' failed: {exc}") from None
+    if result.returncode != 0:
+        raise OrchestraError(f"graphviz 'dot' could not write {out}: "
+                             f"{result.stderr.decode(errors='replace').strip()}")
