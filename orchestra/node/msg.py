@@ -214,6 +214,17 @@ class Registry:
         path = os.path.join(directory, kind, f"{name}.{kind}")
         return path if os.path.isfile(path) else None
 
+    def _read_definition(self, type_name: str, kind: str, why: str = "") -> tuple[str, str]:
+        """(path, text) of the ``.msg``/``.srv`` file defining ``pkg/Name``, or MessageNotFound."""
+        pkg, _, name = type_name.partition("/")
+        path = self._definition_file(pkg, kind, name)
+        if path is None:
+            noun = "message" if kind == "msg" else "service"
+            raise MessageNotFound(f"cannot find {noun} type {type_name} "
+                                  f"({why}no {pkg}/{kind}/{name}.{kind} in a package)")
+        with open(path, encoding="utf-8") as fh:
+            return path, fh.read()
+
     def spec(self, msg_type: str) -> MsgSpec:
         msg_type = normalise_type(msg_type)
         with self._lock:
@@ -229,13 +240,8 @@ class Registry:
                 raise MessageNotFound(f"message type {msg_type!r} must be 'package/Name'")
             if self._from_typestore(msg_type):
                 return self._specs[msg_type]
-            pkg, _, name = msg_type.partition("/")
-            path = self._definition_file(pkg, "msg", name)
-            if path is None:
-                raise MessageNotFound(f"cannot find message type {msg_type} (not a standard "
-                                      f"type, and no {pkg}/msg/{name}.msg in a package)")
-            with open(path, encoding="utf-8") as fh:
-                spec = msgspec.parse_msg(fh.read(), msg_type, path)
+            path, text = self._read_definition(msg_type, "msg", "not a standard type, and ")
+            spec = msgspec.parse_msg(text, msg_type, path)
             self._specs[msg_type] = spec
             return spec
 
@@ -299,13 +305,8 @@ class Registry:
                 return cls
             if "/" not in srv_type:
                 raise MessageNotFound(f"service type {srv_type!r} must be 'package/Name'")
-            pkg, _, name = srv_type.partition("/")
-            path = self._definition_file(pkg, "srv", name)
-            if path is None:
-                raise MessageNotFound(f"cannot find service type {srv_type} "
-                                      f"(no {pkg}/srv/{name}.srv in a package)")
-            with open(path, encoding="utf-8") as fh:
-                spec = msgspec.parse_srv(fh.read(), srv_type, path)
+            path, text = self._read_definition(srv_type, "srv")
+            spec = msgspec.parse_srv(text, srv_type, path)
             cls = self._build_service(spec)
             self._srv_classes[srv_type] = cls
             return cls
