@@ -20,6 +20,7 @@ Run:  python bench/bench_packages.py [--quick] [--repeat N] [--json out.json]
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import shutil
@@ -76,6 +77,25 @@ def synthetic_tree(root: str, groups: int = 40, per_group: int = 50) -> str:
     return root
 
 
+@contextlib.contextmanager
+def package_environ(root: str, ros_home: str):
+    """Point the process-wide package index at ``root`` (cache in ``ros_home``), then restore."""
+    keys = ("ROS_PACKAGE_PATH", "CMAKE_PREFIX_PATH", "ROS_HOME")
+    saved = {k: os.environ.get(k) for k in keys}
+    os.environ.update(ROS_PACKAGE_PATH=root, ROS_HOME=ros_home)
+    os.environ.pop("CMAKE_PREFIX_PATH", None)
+    reset_index()
+    try:
+        yield
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+        reset_index()
+
+
 def timed(fn, repeat: int) -> float:
     """Median seconds of ``repeat`` calls."""
     samples = []
@@ -107,20 +127,9 @@ def bench_tree(label: str, root: str, repeat: int, results: dict) -> None:
         some_names = sorted(index.packages)
         names = [some_names[i % len(some_names)] for i in range(1000)]
         # through the public entry point the launch interpreter uses, process index built once
-        saved = {k: os.environ.get(k) for k in ("ROS_PACKAGE_PATH", "CMAKE_PREFIX_PATH", "ROS_HOME")}
-        os.environ.update(ROS_PACKAGE_PATH=root, ROS_HOME=cache_root)
-        os.environ.pop("CMAKE_PREFIX_PATH", None)
-        reset_index()
-        try:
+        with package_environ(root, cache_root):
             find_package(names[0])
             finds_t = timed(lambda: [find_package(n) for n in names], repeat)
-        finally:
-            for k, v in saved.items():
-                if v is None:
-                    os.environ.pop(k, None)
-                else:
-                    os.environ[k] = v
-            reset_index()
         results[label] = {
             "packages": len(index.packages),
             "catkin_pkg_find_packages_s": baseline,
@@ -213,28 +222,16 @@ def bench_ros1(label: str, root: str, repeat: int, results: dict, rows: list) ->
                 print(f"real roslaunch failed on the $(find) launch: {res['errors'][0]}")
             else:
                 from orchestra.launch.interpreter import Interpreter, LoadOptions
-                saved = {k: os.environ.get(k) for k in ("ROS_PACKAGE_PATH", "ROS_HOME",
-                                                        "CMAKE_PREFIX_PATH")}
-                os.environ.update(ROS_PACKAGE_PATH=root, ROS_HOME=o_home)
-                os.environ.pop("CMAKE_PREFIX_PATH", None)
-                reset_index()
 
                 def o_load():
                     interp = Interpreter(LoadOptions(no_exec=True))
                     interp.load_file(launch)
                     interp.plan()
-                try:
+                with package_environ(root, o_home):
                     start = time.perf_counter()
                     o_load()
                     o_first = time.perf_counter() - start
                     o_warm = min(timed(o_load, 1) for _ in range(3))
-                finally:
-                    for k, v in saved.items():
-                        if v is None:
-                            os.environ.pop(k, None)
-                        else:
-                            os.environ[k] = v
-                    reset_index()
                 rows.append(("  in-process, first load (index from disk cache / crawl)",
                              o_first, res["first"][0], ""))
                 rows.append(("  in-process, later loads (index reused)", o_warm,
