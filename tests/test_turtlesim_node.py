@@ -2,12 +2,15 @@
 a client process through the topic/service API against a master on a free port."""
 from __future__ import annotations
 
+import contextlib
 import json
-import shutil
 import os
+import select
+import shutil
 import signal
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -144,43 +147,67 @@ def test_gui_requested_on_an_unusable_display_falls_back_to_headless(master):
     assert "Traceback" not in output
 
 
-def _free_display() -> int:
-    """A display number no X server (or lock) uses yet."""
-    for number in range(170, 400):
-        if not os.path.exists(f"/tmp/.X{number}-lock") and \
-                not os.path.exists(f"/tmp/.X11-unix/X{number}"):
-            return number
-    pytest.skip("no free X display number")
+@contextlib.contextmanager
+def _virtual_screen():
+    """Start Xvfb on a display it picks itself and yield ":N" once it accepts clients.
+
+    `-displayfd` makes Xvfb choose a free display and write its number only when the server
+    is ready, so the node under test never races a half-started X server (a Tk that cannot
+    connect falls back to headless, and the window would never appear).
+    """
+    read_end, write_end = os.pipe()
+    log = tempfile.TemporaryFile()
+    xvfb = subprocess.Popen(["Xvfb", "-displayfd", str(write_end), "-screen", "0", "800x600x24",
+                             "-nolisten", "tcp"], pass_fds=(write_end,),
+                            stdout=subprocess.DEVNULL, stderr=log)
+    os.close(write_end)
+    try:
+        ready, _, _ = select.select([read_end], [], [], 60)
+        number = os.read(read_end, 32).decode().strip() if ready else ""
+        if not number:
+            xvfb.kill()
+            xvfb.wait()
+            log.seek(0)
+            pytest.fail(f"Xvfb did not start: {log.read().decode(errors='replace')[-2000:]}")
+        yield f":{number}"
+    finally:
+        os.close(read_end)
+        log.close()
+        if xvfb.poll() is None:
+            xvfb.terminate()
+            try:
+                xvfb.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                xvfb.kill()
+                xvfb.wait()
 
 
-@pytest.mark.timeout(90)
+@pytest.mark.timeout(120)
 @pytest.mark.skipif(not (shutil.which("Xvfb") and shutil.which("xwd")),
                     reason="Xvfb and xwd (Debian xvfb, x11-apps) are not installed")
 def test_gui_window_shows_the_canvas_on_a_real_x_server(master, tmp_path):
     """On a desktop (DISPLAY set) turtlesim opens its Tk window: dump it and find the canvas."""
+    with _virtual_screen() as display:
+        _check_turtlesim_window(master, tmp_path, display)
+
+
+def _check_turtlesim_window(master: str, tmp_path, display: str) -> None:
     import time
 
-    display = f":{_free_display()}"
-    xvfb = subprocess.Popen(["Xvfb", display, "-screen", "0", "800x600x24", "-nolisten", "tcp"],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     env = dict(BUNDLED_ENV, ROS_MASTER_URI=master, DISPLAY=display, PYTHONUNBUFFERED="1")
     sim = subprocess.Popen([str(SIM)], env=env, stdout=subprocess.PIPE,
                            stderr=subprocess.STDOUT, text=True)
     dump = tmp_path / "window.xwd"
+    appeared = False
     try:
         deadline = time.monotonic() + 40
-        while time.monotonic() < deadline:
+        while time.monotonic() < deadline and sim.poll() is None:
             grabbed = subprocess.run(["xwd", "-silent", "-name", "TurtleSim", "-out", str(dump)],
                                      env=env, capture_output=True, timeout=20)
             if grabbed.returncode == 0 and dump.stat().st_size > 500 * 500 * 3:
+                appeared = True
                 break
             time.sleep(0.3)
-        else:
-            pytest.fail("no TurtleSim window appeared")
-        # 24/32-bit TrueColor dumps store pixels as B, G, R, pad: the default background
-        # (69, 86, 255) must fill most of the window
-        pixels = dump.read_bytes()
-        assert pixels.count(bytes((255, 86, 69))) > 200_000
     finally:
         sim.send_signal(signal.SIGINT)
         try:
@@ -188,7 +215,9 @@ def test_gui_window_shows_the_canvas_on_a_real_x_server(master, tmp_path):
         except subprocess.TimeoutExpired:
             sim.kill()
             output, _ = sim.communicate()
-        xvfb.terminate()
-        xvfb.wait(timeout=10)
+    assert appeared, f"no TurtleSim window appeared on {display}; turtlesim said:\n{output}"
+    # 24/32-bit TrueColor dumps store pixels as B, G, R, pad: the default background
+    # (69, 86, 255) must fill most of the window
+    assert dump.read_bytes().count(bytes((255, 86, 69))) > 200_000
     assert sim.returncode == 0, output
     assert "running headless" not in output and "Traceback" not in output
