@@ -10,12 +10,14 @@ import sys
 
 import pytest
 
-from conftest import COMPAT
+from conftest import COMPAT, REPO
 from orchestra.errors import OrchestraError
 from orchestra.launch import convert, xml as xml_frontend, yaml as yaml_frontend
 from orchestra.launch.entity import Entity
 
 WS = COMPAT / "ws"
+# the bundled demo, so these tests run without ../shared
+DEMO = REPO / "packages" / "turtle_tf" / "launch" / "turtle_tf_demo.launch"
 SMOKE = json.loads((COMPAT / "smoke.json").read_text()) if COMPAT.is_dir() else []
 CASES = json.loads((COMPAT / "cases.json").read_text()) if COMPAT.is_dir() else []
 
@@ -65,7 +67,7 @@ def test_xml_to_yaml_to_xml_round_trip_keeps_every_entity(launch_file, tmp_path)
 
 
 def test_converted_yaml_keeps_line_numbers_meaningful():
-    original = xml_frontend.parse_file(str(WS / "turtle_tf/launch/turtle_tf_demo.launch"))
+    original = xml_frontend.parse_file(str(DEMO))
     yaml_text = convert.to_yaml(original)
     root = yaml_frontend.parse_string(yaml_text, "demo.launch.yaml")
     lines = yaml_text.splitlines()
@@ -267,7 +269,7 @@ def test_yaml_aliases_are_written_back_with_roslaunch_names(tmp_path):
 # ------------------------------------------------------------------------------ the CLI
 
 def test_cli_convert_file_prints_yaml_that_reads_back_the_same():
-    path = WS / "turtle_tf/launch/turtle_tf_demo.launch"
+    path = DEMO
     proc = run_cli("convert", str(path), "--to", "yaml")
     assert proc.returncode == 0, proc.stderr
     assert shape(yaml_frontend.parse_string(proc.stdout, "x.yaml")) == \
