@@ -106,6 +106,57 @@ def test_sigkilled_orchestra_launch_leaves_no_node_or_grandchild(launch_env):
         proc.communicate()
 
 
+DETACHER = """#!/bin/sh
+# a node that starts a helper in a session of its own (out of reach of its process group),
+# records both pids, then waits -- or, with "exit", leaves the helper behind at once
+setsid sleep 1000 &
+echo "$$ $!" > "$PIDS_DIR/$1"
+[ "$2" = exit ] && exit 0
+trap 'exit 0' INT TERM
+wait
+"""
+
+
+def add_detacher(launch_env, args: str) -> None:
+    node = Path(launch_env["launch"]).parent.parent / "nodes" / "detacher"
+    node.write_text(DETACHER)
+    node.chmod(0o755)
+    Path(launch_env["launch"]).write_text(
+        f'<launch><node pkg="demo" type="detacher" name="d" args="{args}"/></launch>')
+
+
+def test_sigkilled_orchestra_leaves_no_grandchild_that_called_setsid(launch_env):
+    add_detacher(launch_env, "d")
+    proc = start(launch_env)
+    try:
+        node, helper = wait_pids(launch_env, proc, names=("d",))
+        assert os.getsid(helper) != os.getsid(node)      # really out of the node's session
+        proc.kill()
+        proc.wait(timeout=10)
+        assert survivors([node, helper]) == []
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        proc.communicate()
+
+
+def test_stop_ends_what_an_exited_node_left_outside_its_process_group(launch_env):
+    add_detacher(launch_env, "d exit")
+    proc = start(launch_env)
+    try:
+        node, helper = wait_pids(launch_env, proc, names=("d",))
+        assert survivors([node]) == []        # the node is gone: its helper is an orphan
+        assert alive(helper)
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert proc.returncode == 0, err
+    assert survivors([helper], limit=3) == []
+    assert f"{helper} (sleep)" in err and "outside their process groups" in err
+
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP, signal.SIGINT])
 def test_stop_signal_to_orchestra_is_a_graceful_stop(launch_env, sig):
     proc = start(launch_env)

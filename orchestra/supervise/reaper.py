@@ -8,7 +8,12 @@ it is SIGKILLed; orchestra closes the gap twice:
   the child between fork and exec);
 - a tiny forked watchdog process holds the read end of a pipe and learns each node's process
   group; when the pipe closes without a goodbye (orchestra died), it SIGKILLs every group, so
-  grandchildren a node forked die too.
+  grandchildren a node forked die too;
+- every node's environment carries a run mark (``ORCHESTRA_RUN_MARK``), which whatever it
+  starts inherits. A grandchild that left its node's process group and session (``setsid``,
+  a double-forked daemon) is no longer anyone's descendant once its node is gone, but its
+  ``/proc/PID/environ`` still names the run: the watchdog (orchestra killed) and the end of a
+  normal run (nodes that died leaving such strays behind) find those processes by the mark.
 
 Setting the parent-death signal from Python (``preexec_fn``) forces a full fork of the
 interpreter and costs ~7 ms per spawn; util-linux's ``setpriv --pdeathsig`` does the same
@@ -23,6 +28,7 @@ import errno
 import functools
 import logging
 import os
+import secrets
 import shutil
 import signal
 import subprocess
@@ -34,6 +40,7 @@ import psutil
 logger = logging.getLogger(__name__)
 
 PR_SET_PDEATHSIG = 1
+MARK_VARIABLE = "ORCHESTRA_RUN_MARK"
 
 try:
     _libc = ctypes.CDLL(None, use_errno=True)
@@ -118,6 +125,37 @@ def descendants(roots: Iterable[int]) -> dict[int, list[int]]:
     return result
 
 
+def new_mark() -> str:
+    """A value for MARK_VARIABLE that no other run on this machine uses."""
+    return f"{os.getpid()}-{secrets.token_hex(8)}"
+
+
+def marked_pids(mark: str, exclude: Iterable[int] = ()) -> list[int]:
+    """Live processes whose initial environment carries ``MARK_VARIABLE=mark``.
+
+    Plain reads of ``/proc`` (no psutil, no threads): the watchdog calls this in a forked
+    child. Processes of other users, and those that vanish mid-scan, are skipped.
+    """
+    needle = f"{MARK_VARIABLE}={mark}".encode()
+    skip = set(exclude) | {os.getpid()}
+    found: list[int] = []
+    try:
+        entries = os.listdir("/proc")
+    except OSError:
+        return found
+    for entry in entries:
+        if not entry.isdigit() or int(entry) in skip:
+            continue
+        try:
+            with open(f"/proc/{entry}/environ", "rb") as fh:
+                environ = fh.read()
+        except OSError:
+            continue
+        if needle in environ.split(b"\0"):
+            found.append(int(entry))
+    return found
+
+
 class Watchdog:
     """A forked helper that SIGKILLs every registered process group if orchestra dies.
 
@@ -126,6 +164,8 @@ class Watchdog:
     """
 
     def __init__(self) -> None:
+        #: the value of MARK_VARIABLE in every node's environment (unique to this run)
+        self.mark = new_mark()
         read_fd, write_fd = os.pipe()
         with warnings.catch_warnings():
             # Python >= 3.12 warns about fork() with threads running (an embedded master in
@@ -135,7 +175,7 @@ class Watchdog:
         if pid == 0:  # child
             try:
                 os.close(write_fd)
-                _watchdog_main(read_fd)
+                _watchdog_main(read_fd, self.mark)
             finally:
                 os._exit(0)
         os.close(read_fd)
@@ -170,7 +210,7 @@ class Watchdog:
             pass
 
 
-def _watchdog_main(read_fd: int) -> None:
+def _watchdog_main(read_fd: int, mark: str) -> None:
     for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP, signal.SIGPIPE):
         signal.signal(sig, signal.SIG_IGN)
     try:
@@ -208,3 +248,11 @@ def _watchdog_main(read_fd: int) -> None:
         except OSError as exc:
             if exc.errno not in (errno.ESRCH, errno.EPERM):
                 raise
+    # strays that left their node's group (setsid): found by the mark they inherited; a
+    # second pass catches any a dying process forked while the first one ran
+    for _ in range(2):
+        for pid in marked_pids(mark):
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except OSError:
+                pass

@@ -28,8 +28,9 @@ from orchestra.supervise.loop import EventLoop, Timer
 from orchestra.supervise.output import NodeOutput, Screen
 from orchestra.supervise.process import (TERMINAL, ManagedProcess, ProcessSpec, RestartPolicy,
                                          State, describe_exit, restart_delay)
-from orchestra.supervise.reaper import (Watchdog, check_executable, child_setup, descendants,
-                                        setpriv_prefix, signal_group)
+from orchestra.supervise.reaper import (MARK_VARIABLE, Watchdog, check_executable, child_setup,
+                                        descendants, marked_pids, new_mark, setpriv_prefix,
+                                        signal_group)
 
 logger = logging.getLogger(__name__)
 
@@ -68,6 +69,10 @@ class Supervisor:
         self.screen = screen or Screen()
         self.log_dir = log_dir
         self.watchdog = watchdog
+        # inherited by everything a node starts: how strays that escaped the process tree
+        # are found at the end of the run (and by the watchdog if orchestra is killed)
+        self.mark = watchdog.mark if watchdog is not None else new_mark()
+        self.stray_timeout = 2.0
         self.on_change = on_change
         if pdeathsig in ("auto", "setpriv") and not setpriv_prefix():
             pdeathsig = "preexec"          # same guarantee, slower spawn
@@ -168,6 +173,7 @@ class Supervisor:
             deadline = time.monotonic() + 1.0
             while self._open_pipes and time.monotonic() < deadline:
                 self.loop.run_once(limit=max(0.0, deadline - time.monotonic()))
+            self._stop_strays()
         finally:
             if restore is not None:
                 restore()
@@ -190,7 +196,8 @@ class Supervisor:
             elif self.pdeathsig == "preexec":
                 preexec = child_setup(self._pid)
             popen = subprocess.Popen(
-                argv, cwd=spec.cwd, env=dict(spec.env), stdin=None,  # inherited, as roslaunch
+                argv, cwd=spec.cwd, env={**spec.env, MARK_VARIABLE: self.mark},
+                stdin=None,  # inherited, as roslaunch
                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, close_fds=True,
                 start_new_session=True, preexec_fn=preexec)
         except (OSError, subprocess.SubprocessError) as exc:
@@ -402,6 +409,43 @@ class Supervisor:
             os.close(write_fd)
 
         return restore
+
+    def _stop_strays(self) -> None:
+        """Stop what nodes left running outside their process groups (setsid, daemons).
+
+        Every node is gone by now, so anything still carrying this run's mark escaped its
+        node's group: it gets SIGTERM, then SIGKILL after ``stray_timeout``. roslaunch leaves
+        such processes running forever.
+        """
+        strays = []
+        for pid in marked_pids(self.mark):
+            try:
+                strays.append(psutil.Process(pid))
+            except psutil.NoSuchProcess:
+                pass
+        if not strays:
+            return
+        names = []
+        for ps in strays:
+            try:
+                names.append(f"{ps.pid} ({ps.name()})")
+            except psutil.Error:
+                names.append(str(ps.pid))
+        self.screen.message(f"orchestra: stopping {len(strays)} process(es) that nodes left "
+                            f"running outside their process groups: {', '.join(names)}",
+                            err=True)
+        for ps in strays:
+            try:
+                ps.terminate()
+            except psutil.Error:
+                pass
+        _, alive = psutil.wait_procs(strays, timeout=self.stray_timeout)
+        for ps in alive:
+            try:
+                ps.kill()
+            except psutil.Error:
+                pass
+        psutil.wait_procs(alive, timeout=self.stray_timeout)
 
     def _close(self) -> None:
         for output in self.outputs.values():
