@@ -125,6 +125,17 @@ print(m.x)
 '''
 
 
+def _interrupt(sim: subprocess.Popen) -> str:
+    """Ctrl-C the node (SIGKILL if it hangs) and return everything it printed."""
+    sim.send_signal(signal.SIGINT)
+    try:
+        output, _ = sim.communicate(timeout=15)
+    except subprocess.TimeoutExpired:
+        sim.kill()
+        output, _ = sim.communicate()
+    return output
+
+
 @pytest.mark.timeout(60)
 def test_gui_requested_on_an_unusable_display_falls_back_to_headless(master):
     env = dict(BUNDLED_ENV, ROS_MASTER_URI=master, DISPLAY=":987", PYTHONUNBUFFERED="1")
@@ -136,12 +147,7 @@ def test_gui_requested_on_an_unusable_display_falls_back_to_headless(master):
         assert reader.returncode == 0, reader.stderr
         assert float(reader.stdout.split()[-1]) == pytest.approx(5.544, abs=1e-3)
     finally:
-        sim.send_signal(signal.SIGINT)
-        try:
-            output, _ = sim.communicate(timeout=15)
-        except subprocess.TimeoutExpired:
-            sim.kill()
-            output, _ = sim.communicate()
+        output = _interrupt(sim)
     assert sim.returncode == 0
     assert "cannot open a window" in output and "running headless" in output
     assert "Traceback" not in output
@@ -209,12 +215,7 @@ def _check_turtlesim_window(master: str, tmp_path, display: str) -> None:
                 break
             time.sleep(0.3)
     finally:
-        sim.send_signal(signal.SIGINT)
-        try:
-            output, _ = sim.communicate(timeout=15)
-        except subprocess.TimeoutExpired:
-            sim.kill()
-            output, _ = sim.communicate()
+        output = _interrupt(sim)
     assert appeared, f"no TurtleSim window appeared on {display}; turtlesim said:\n{output}"
     # 24/32-bit TrueColor dumps store pixels as B, G, R, pad: the default background
     # (69, 86, 255) must fill most of the window
