@@ -4,6 +4,9 @@
     TransformBroadcaster().sendTransform((x, y, 0), q, Time.now(), "turtle1", "world")
     trans, rot = TransformListener().lookupTransform("turtle2", "turtle1", Time(0))
 
+tf2_ros's API (a ``Buffer`` whose lookups return TransformStamped messages, fed by
+``TransformListener(buffer)``) is ``orchestra.tf.tf2_ros``, a thin layer over the same parts.
+
 The math (``transformations``) and the tree (``buffer``) are pure; the broadcaster and
 listener import the node runtime only when constructed, so importing this package is cheap.
 """
