@@ -6,8 +6,8 @@ protocol is ROS 1's TCPROS, so these nodes talk to rospy/roscpp nodes and to a r
 rosmaster as well as to orchestra's. Message classes come from ``orchestra.node.msg``.
 """
 from orchestra.node.exceptions import (ROSException, ROSInitException, ROSInterruptException,
-                                       SerializationError, ServiceException,
-                                       TransportException)
+                                       ROSTimeMovedBackwardsException, SerializationError,
+                                       ServiceException, TransportException)
 from orchestra.node.msg import AnyMsg, get_message_class, get_service_class
 from orchestra.node.rostime import Duration, Rate, Time, get_rostime, get_time, sleep
 from orchestra.node.runtime import (delete_param, get_caller_id, get_master_uri, get_name,
@@ -24,7 +24,8 @@ from orchestra.node.topics import Publisher, Subscriber
 
 __all__ = [
     "AnyMsg", "Duration", "Publisher", "ROSException", "ROSInitException",
-    "ROSInterruptException", "Rate", "SerializationError", "Service", "ServiceException",
+    "ROSInterruptException", "ROSTimeMovedBackwardsException", "Rate", "SerializationError",
+    "Service", "ServiceException",
     "ServiceProxy", "Subscriber", "Time", "Timer", "TimerEvent", "TransportException", "delete_param",
     "get_caller_id", "get_master_uri", "get_message_class", "get_name", "get_namespace",
     "get_node_uri", "get_param", "get_param_cached", "get_param_names",

@@ -79,11 +79,13 @@ def _message_class(type_name: str):
 
 
 def _start_cli_node():
-    """This process as an anonymous node (as rostopic does), without signal handlers."""
+    """This process as an anonymous node (as rostopic does), without signal handlers, on
+    wall time even under /use_sim_time (rostopic pub's default), so ``topic pub -r`` can be
+    the /clock publisher itself."""
     import orchestra.node as rospy
     _require_master(_master_uri())
     rospy.init_node(CLI_NODE, argv=[], anonymous=True, disable_signals=True,
-                    disable_rosout=True)
+                    disable_rosout=True, disable_rostime=True)
     return rospy
 
 

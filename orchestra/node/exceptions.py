@@ -13,6 +13,18 @@ class ROSInterruptException(ROSException, KeyboardInterrupt):
     """
 
 
+class ROSTimeMovedBackwardsException(ROSInterruptException):
+    """Simulated time (``/clock``) jumped backwards while ``sleep``/``Rate.sleep`` waited.
+
+    ``time`` is the size of the jump in seconds. A subclass of ROSInterruptException, as in
+    rospy, so loops that stop on an interrupt stop on a jump too.
+    """
+
+    def __init__(self, time: float):
+        super().__init__("ROS time moved backwards")
+        self.time = time
+
+
 class ROSInitException(ROSException):
     """``init_node`` could not be completed (bad name, called twice with another name)."""
 

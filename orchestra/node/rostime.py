@@ -3,12 +3,18 @@
 Both are normalised so that ``0 <= nsecs < 1e9``; on the wire they are two 32-bit integers
 (unsigned for Time, signed for Duration), which is why they are kept as integers here rather
 than floats: a round trip through a message must give back exactly what was sent.
+
+ROS time is wall time, or simulated time when ``/use_sim_time`` is true at ``init_node``:
+then ``Time.now()`` is the last ``/clock`` message and ``sleep``, ``Rate`` and ``Timer`` wait
+for /clock to advance (see "the time source" below).
 """
 from __future__ import annotations
 
 import functools
 import threading
 import time as _time
+
+from orchestra.node.exceptions import ROSInterruptException, ROSTimeMovedBackwardsException
 
 
 def _normalise(secs: int, nsecs: int) -> tuple[int, int]:
@@ -104,7 +110,7 @@ class Duration(_TimeBase):
 
 
 class Time(_TimeBase):
-    """A point in (wall) time since the Unix epoch."""
+    """A point in ROS time: wall time since the Unix epoch, or the simulated ``/clock``."""
 
     __slots__ = ()
 
@@ -115,7 +121,9 @@ class Time(_TimeBase):
 
     @classmethod
     def now(cls) -> "Time":
-        return cls(0, _time.time_ns())
+        """The current ROS time: the last ``/clock`` message under simulated time (0 until
+        the first one arrives), otherwise wall time."""
+        return cls(0, _now_ns())
 
     def __add__(self, other):
         if isinstance(other, Duration):
@@ -132,16 +140,60 @@ class Time(_TimeBase):
         return NotImplemented
 
 
+# --- the time source ----------------------------------------------------------------------------
+#
+# Wall time unless init_node found /use_sim_time set: then ``_sim_ns`` holds the last /clock
+# value (0 before the first message) and every sleep waits on ``_clock`` for it to advance.
+# /clock messages, shutdown and Timer.shutdown() notify ``_clock``; waits also look again
+# every half second, so nothing depends on a notification arriving.
+
+_sim_ns: int | None = None
+_clock = threading.Condition()
+_shutdown_event = threading.Event()
+_POLL = 0.5
+
+
+def _now_ns() -> int:
+    sim = _sim_ns
+    return _time.time_ns() if sim is None else sim
+
+
+def is_wallclock() -> bool:
+    """True unless this node follows simulated time (``/use_sim_time`` at init_node)."""
+    return _sim_ns is None
+
+
+def _use_sim_time() -> None:
+    """Switch to simulated time (init_node, when /use_sim_time is true): time is 0 until
+    the first /clock message."""
+    global _sim_ns
+    with _clock:
+        if _sim_ns is None:
+            _sim_ns = 0
+
+
+def _set_sim_time(stamp: Time) -> None:
+    """A /clock message arrived (called from the /clock subscriber's thread)."""
+    global _sim_ns
+    with _clock:
+        _sim_ns = stamp.to_nsec()
+        _clock.notify_all()
+
+
+def _wake_sleepers() -> None:
+    """Make waits on the simulated clock look at shutdown/cancellation now. Not for signal
+    handlers (it takes a lock): the runtime calls it from its cleanup thread."""
+    with _clock:
+        _clock.notify_all()
+
+
 def get_time() -> float:
-    """Current time in float seconds (rospy.get_time)."""
-    return _time.time()
+    """Current ROS time in float seconds (rospy.get_time)."""
+    return _now_ns() / 1e9
 
 
 def get_rostime() -> Time:
     return Time.now()
-
-
-_shutdown_event = threading.Event()
 
 
 def _set_shutdown_event(event: threading.Event) -> None:
@@ -150,35 +202,107 @@ def _set_shutdown_event(event: threading.Event) -> None:
     _shutdown_event = event
 
 
-def sleep(duration: float | Duration) -> None:
-    """Sleep, but wake up and raise ``ROSInterruptException`` when the node shuts down."""
-    from orchestra.node.exceptions import ROSInterruptException
+def _to_ns(duration: float | Duration) -> int:
+    if isinstance(duration, Duration):
+        return duration.to_nsec()
+    return int(round(float(duration) * 1e9))
 
-    seconds = duration.to_sec() if isinstance(duration, Duration) else float(duration)
-    if seconds <= 0:
+
+def _wait_sim(target_ns: int | None, start_ns: int,
+              cancelled: threading.Event | None = None) -> int | None:
+    """Wait for the simulated clock: until it reaches ``target_ns``, or with ``target_ns``
+    None until it is non-zero (the first /clock). Returns the clock value, None if
+    ``cancelled`` got set. ROSInterruptException at shutdown;
+    ROSTimeMovedBackwardsException when the clock goes below ``start_ns``."""
+    with _clock:
+        while True:
+            if _shutdown_event.is_set():
+                raise ROSInterruptException("ROS shutdown request")
+            if cancelled is not None and cancelled.is_set():
+                return None
+            now = _sim_ns
+            if now is None:  # cannot happen (no way back to wall time); do not hang
+                return _now_ns()
+            if now < start_ns:
+                raise ROSTimeMovedBackwardsException((start_ns - now) / 1e9)
+            reached = now > 0 if target_ns is None else now >= target_ns
+            if reached:
+                return now
+            _clock.wait(_POLL)
+
+
+def _first_clock(cancelled: threading.Event | None = None) -> int | None:
+    """The current ROS time in ns; under simulated time, wait for the first /clock first."""
+    if _sim_ns is None:
+        return _time.time_ns()
+    return _wait_sim(None, 0, cancelled)
+
+
+def sleep(duration: float | Duration) -> None:
+    """Sleep for ``duration`` of ROS time, waking up and raising ``ROSInterruptException``
+    when the node shuts down. Under simulated time the sleep ends when /clock reaches the
+    target (it waits for the first /clock before it starts counting) and raises
+    ``ROSTimeMovedBackwardsException`` when /clock jumps back before the start."""
+    span = _to_ns(duration)
+    if _sim_ns is not None:
+        start = _first_clock()
+        _wait_sim(start + span, start)
         return
-    if _shutdown_event.wait(seconds):
+    if span <= 0:
+        return
+    if _shutdown_event.wait(span / 1e9):
         raise ROSInterruptException("ROS shutdown request")
 
 
 class Rate:
-    """Keep a loop at ``hz`` iterations per second, absorbing the loop body's own time."""
+    """Keep a loop at ``hz`` iterations per second of ROS time, absorbing the loop body's own
+    time. Under wall time it runs on the monotonic clock; under simulated time on /clock.
+
+    ``Rate.sleep`` raises ``ROSTimeMovedBackwardsException`` when /clock jumps back during the
+    sleep, unless ``reset`` is true: then it returns and restarts the schedule from the new
+    time. A jump back between two sleeps just restarts the schedule (as in rospy)."""
 
     def __init__(self, hz: float, reset: bool = False):
         if hz <= 0:
             raise ValueError("Rate needs a positive frequency")
         self.period = 1.0 / hz
+        self._period_ns = int(round(1e9 / hz))
         self.reset = reset
-        self._last = _time.monotonic()
+        self._sim, self._last = self._clock_now()
+
+    @staticmethod
+    def _clock_now() -> tuple[bool, int]:
+        if _sim_ns is None:
+            return False, _time.monotonic_ns()
+        return True, _sim_ns
+
+    def _now(self) -> int:
+        sim, now = self._clock_now()
+        if sim != self._sim:  # made before init_node switched to simulated time
+            self._sim, self._last = sim, now
+        if now < self._last:  # the clock went back since the last sleep
+            self._last = now
+        return now
 
     def remaining(self) -> Duration:
-        return Duration.from_sec(self._last + self.period - _time.monotonic())
+        now = self._now()
+        return Duration(0, self._last + self._period_ns - now)
 
     def sleep(self) -> None:
-        now = _time.monotonic()
-        deadline = self._last + self.period
-        if now > deadline + self.period:
-            # fell far behind (or the clock jumped): restart the schedule instead of bursting
+        now = self._now()
+        deadline = self._last + self._period_ns
+        if now > deadline + self._period_ns:
+            # fell far behind (or the clock jumped ahead): restart the schedule, no burst
             deadline = now
+        if not self._sim:
+            self._last = deadline
+            sleep(Duration(0, deadline - now))
+            return
+        try:
+            _wait_sim(deadline, now)
+        except ROSTimeMovedBackwardsException:
+            if not self.reset:
+                raise
+            self._last = self._clock_now()[1]
+            return
         self._last = deadline
-        sleep(deadline - now)

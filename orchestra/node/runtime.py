@@ -272,6 +272,7 @@ class NodeRuntime:
             thread.join(timeout)
 
     def _do_cleanup(self) -> None:
+        rostime._wake_sleepers()  # waits on /clock see the shutdown now (not from a signal)
         for hook in list(self._hooks):
             _call_hook(hook, self._shutdown_reason)
         self.topics.close_all()
@@ -321,7 +322,8 @@ def init_node(name: str, argv: list[str] | None = None, anonymous: bool = False,
               xmlrpc_port: int = 0, tcpros_port: int = 0) -> None:
     """Make this process the node ``name`` (see rospy.init_node; same argv conventions).
 
-    ``disable_rostime`` is accepted for rospy compatibility; time is always wall time."""
+    When the parameter ``/use_sim_time`` is true (and not ``disable_rostime``), ROS time is
+    the simulated time of ``/clock`` (rosgraph_msgs/Clock), as in rospy."""
     global _runtime
     argv = list(sys.argv if argv is None else argv)
     parsed = names.parse_args(argv)
@@ -360,6 +362,28 @@ def init_node(name: str, argv: list[str] | None = None, anonymous: bool = False,
         runtime.master_retry("setParam", runtime.resolve_name("~" + key), value)
     if not disable_rosout:
         runtime.rosout = _make_rosout()
+    if not disable_rostime and _param_is_true(runtime, "/use_sim_time"):
+        runtime.clock_sub = _follow_clock()
+
+
+def _param_is_true(runtime: NodeRuntime, key: str) -> bool:
+    """Whether the master has ``key`` set to a true value (waiting for the master)."""
+    try:
+        return bool(runtime.master_retry("getParam", key))
+    except ROSInterruptException:
+        raise
+    except ROSException:  # not set
+        return False
+
+
+def _follow_clock():
+    """Simulated time: ROS time is 0 until the first /clock message, then the last one."""
+    from orchestra.node.msg import get_message_class
+    from orchestra.node.topics import Subscriber
+
+    rostime._use_sim_time()
+    return Subscriber("/clock", get_message_class("rosgraph_msgs/Clock"),
+                      lambda msg: rostime._set_sim_time(msg.clock), queue_size=1)
 
 
 _previous_handlers: dict[int, Any] = {}
