@@ -52,6 +52,16 @@ def wait_until(predicate, timeout: float = 15.0) -> bool:
     return False
 
 
+def read_until(proc: subprocess.Popen, text: str) -> str:
+    """The process's output up to the first line containing ``text`` (or to its end)."""
+    seen = []
+    for line in proc.stdout:
+        seen.append(line)
+        if text in line:
+            break
+    return "".join(seen)
+
+
 def test_loaded_nodelet_lives_in_the_manager_under_the_loaders_name(master, spawn):
     manager = spawn("manager", "__name:=mgr")
     loader = spawn("load", "yocs_cmd_vel_mux/CmdVelMuxNodelet", "mgr", "__name:=mux",
@@ -78,6 +88,9 @@ def test_loader_exits_when_its_manager_dies(master, spawn):
     loader = spawn("load", "yocs_cmd_vel_mux/CmdVelMuxNodelet", "mgr", "__name:=mux",
                    f"_yaml_cfg_file:={MUX_YAML}")
     assert wait_until(lambda: publishers(master, "/mux/active") == ["/mgr"])
+    # the manager registers the nodelet's topics before its load reply reaches the loader:
+    # stop it only once the loader knows the load succeeded
+    assert "loaded into /mgr" in read_until(loader, "loaded into")
     manager.send_signal(signal.SIGINT)
     assert manager.wait(timeout=15) == 0
     assert loader.wait(timeout=15) == 1
