@@ -10,6 +10,7 @@ import re
 import shutil
 import signal
 import subprocess
+import threading
 from pathlib import Path
 
 import pytest
@@ -106,7 +107,7 @@ def master():
     handle.shutdown()
 
 
-@pytest.mark.timeout(60)
+@pytest.mark.timeout(120)
 def test_static_transform_reaches_tf_echo_and_view_frames(master, tmp_path):
     env = dict(BUNDLED_ENV, ROS_MASTER_URI=master, PYTHONUNBUFFERED="1")
     procs = []
@@ -118,17 +119,27 @@ def test_static_transform_reaches_tf_echo_and_view_frames(master, tmp_path):
             [str(SCRIPTS / "static_transform_publisher"), "0", "0", "0", "0", "0", "0", "1",
              "odom", "base_link", "20"], env=env, stdout=subprocess.DEVNULL,
             stderr=subprocess.DEVNULL))
+        echo_err = open(tmp_path / "tf_echo.err", "w+")
         echo = subprocess.Popen([str(SCRIPTS / "tf_echo"), "odom", "laser", "10"], env=env,
-                                stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+                                stdout=subprocess.PIPE, stderr=echo_err, text=True)
         procs.append(echo)
+        lines: list[str] = []
+        complete = threading.Event()
+
+        def read_echo() -> None:
+            for line in echo.stdout:
+                lines.append(line)
+                if line.startswith("            in RPY (degree)"):
+                    complete.set()
+                    return
+        threading.Thread(target=read_echo, daemon=True).start()
         view = subprocess.run([str(SCRIPTS / "view_frames"), "2", str(tmp_path / "frames")],
                               env=env, capture_output=True, text=True, timeout=40)
         assert view.returncode == 0, view.stderr
-        lines = []
-        for line in echo.stdout:
-            lines.append(line)
-            if line.startswith("            in RPY (degree)"):
-                break
+        if not complete.wait(30):
+            echo_err.seek(0)
+            pytest.fail("tf_echo printed no full transform; stdout:\n" + "".join(lines)[-3000:]
+                        + "\nstderr:\n" + echo_err.read()[-3000:])
         text = "".join(lines)
         assert "- Translation: [1.000, 2.000, 0.000]" in text
         assert re.search(r"in RPY \(degree\) \[0\.000, -?0\.000, 90\.000\]", text)
