@@ -219,6 +219,33 @@ def test_install_space_package_brings_its_lib_dir_without_cmake_prefix_path(tmp_
         reset_index()
 
 
+
+@pytest.mark.parametrize("system", [True, False])
+def test_debian_system_package_brings_its_lib_dir_without_a_catkin_marker(
+        system, tmp_path, monkeypatch):
+    """Debian installs /usr/share/topic_tools/package.xml and /usr/lib/topic_tools/relay, with
+    no .catkin in /usr: its catkin counts /usr as a workspace anyway, so roslaunch finds relay.
+    Any other unmarked prefix (/usr/local, a conda env) still does not bring its lib/ along."""
+    from orchestra.packages import executables
+
+    prefix = tmp_path / "usr"
+    package(prefix / "share", "topic_tools")
+    binary = script(prefix / "lib" / "topic_tools" / "relay")
+    monkeypatch.setattr(executables, "SYSTEM_PREFIXES", (str(prefix),) if system else ())
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(prefix / "share"))
+    monkeypatch.setenv("ROS_HOME", str(tmp_path / "rh"))
+    monkeypatch.delenv("CMAKE_PREFIX_PATH", raising=False)
+    monkeypatch.chdir(tmp_path)
+    reset_index()
+    try:
+        if system:
+            assert find_executable("topic_tools", "relay") == str(binary)
+        else:
+            with pytest.raises(ExecutableNotFound):
+                find_executable("topic_tools", "relay")
+    finally:
+        reset_index()
+
 def test_pkg_plugins_lists_exports_of_packages_depending_on_the_tool(env, tmp_path):
     package(env, "tool")
     user = package(env, "user", ["tool"])

@@ -2,9 +2,12 @@
 
 Where roslaunch looks, in order: the package's ``lib/<pkg>`` ("libexec") and ``share/<pkg>``
 directories in the first catkin devel/install space that has either, then the whole package
-tree (symlinks followed, hidden directories skipped). A candidate must be a regular file the
-user may execute. Several distinct matches in the same place are an error naming all of them
-(roslaunch silently takes the first one it happens to walk into).
+tree (symlinks followed, hidden directories skipped). Debian's own ROS packages count too:
+they put ``package.xml`` in ``/usr/share/<pkg>`` and the binaries in ``/usr/lib/<pkg>``
+(``/usr/lib/topic_tools/relay``), and Debian's catkin treats ``/usr`` as a workspace without a
+``.catkin`` marker. A candidate must be a regular file the user may execute. Several distinct
+matches in the same place are an error naming all of them (roslaunch silently takes the first
+one it happens to walk into).
 """
 from __future__ import annotations
 
@@ -14,6 +17,12 @@ from typing import Mapping
 from orchestra.errors import OrchestraError
 from orchestra.packages.discovery import CATKIN_MARKER, catkin_prefixes, current_directory
 from orchestra.packages.index import find_package
+
+
+#: prefixes that are catkin install spaces without carrying the ``.catkin`` marker: Debian
+#: installs ROS packages straight into ``/usr`` and patches catkin's ``get_workspaces()`` to
+#: always append it, which is how roslaunch there finds ``/usr/lib/topic_tools/relay``
+SYSTEM_PREFIXES = ("/usr",)
 
 
 class ExecutableNotFound(OrchestraError):
@@ -39,7 +48,8 @@ def libexec_dirs(package: str, environ: Mapping[str, str] | None = None,
 
     Besides CMAKE_PREFIX_PATH and the cwd workspace, a package found at
     ``<prefix>/share/<pkg>`` of a catkin prefix brings that prefix along, so pointing only
-    ROS_PACKAGE_PATH at ``/opt/ros/noetic/share`` still finds the binaries in ``lib/``.
+    ROS_PACKAGE_PATH at ``/opt/ros/noetic/share`` still finds the binaries in ``lib/``;
+    so does a package of Debian's found at ``/usr/share/<pkg>`` (:data:`SYSTEM_PREFIXES`).
     """
     env = os.environ if environ is None else environ
     here = current_directory() if cwd is None else cwd
@@ -48,7 +58,8 @@ def libexec_dirs(package: str, environ: Mapping[str, str] | None = None,
         share = os.path.dirname(os.path.abspath(package_dir))
         owner = os.path.dirname(share)
         if (os.path.basename(share) == "share" and owner not in prefixes
-                and os.path.isfile(os.path.join(owner, CATKIN_MARKER))):
+                and (os.path.isfile(os.path.join(owner, CATKIN_MARKER))
+                     or owner in SYSTEM_PREFIXES)):
             prefixes.append(owner)
     for prefix in prefixes:
         found = [d for d in (os.path.join(prefix, "lib", package),
