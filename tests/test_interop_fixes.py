@@ -1,4 +1,5 @@
-"""Fixes found by the real-ROS interop tests (tests/test_interop_ros1.py), pinned without ROS.
+"""Fixes found by the real-ROS interop tests (tests/test_interop_ros1.py and
+tests/test_interop_roscpp.py), pinned without ROS.
 
 Each test reproduces what a real ROS 1 peer does on the wire with a small stand-in, so the
 behaviour stays pinned on machines where Debian's ROS 1 is not installed.
@@ -254,3 +255,91 @@ def test_bus_info_describes_the_socket_as_rospy_does():
             client.close()
             accepted.close()
     assert describe_socket(accepted) == "" and describe_socket(None) == ""
+
+
+def test_string_arrays_print_as_indented_yaml_block_lists_like_genpy():
+    """Found calling roscpp's mux/list: `orchestra service call` printed
+    ``topics: - /a\n- /b`` (not even YAML); rosservice (genpy) prints a block list indented
+    at the field's level, nested ones too."""
+    from orchestra.node.msg import get_message_class, message_class_from_definition, \
+        to_yaml_text
+
+    listing = message_class_from_definition("test_msgs/Topics", "string[] topics\n")
+    assert to_yaml_text(listing(topics=["/a", "/b c", ""])) == \
+        "topics: \n  - /a\n  - /b c\n  - ''"
+    log = get_message_class("rosgraph_msgs/Log")(name="/n", topics=["/rosout", "/x"])
+    assert "\ntopics: \n  - /rosout\n  - /x" in to_yaml_text(log)
+    outer = message_class_from_definition(
+        "test_msgs/Outer", "test_msgs/Topics inner\n"
+        "================================================================================\n"
+        "MSG: test_msgs/Topics\nstring[] topics\n")
+    assert to_yaml_text(outer(inner=listing(topics=["/a"]))) == \
+        "inner: \n  topics: \n    - /a"
+
+
+def test_a_latched_message_that_arrives_before_the_callback_is_added_is_not_lost():
+    """Found with roscpp's topic_tools/mux: /mux/selected (latched) sometimes never reached an
+    orchestra subscriber. The reader thread connects as soon as the master answers, before the
+    Subscriber adds its callback, and roscpp sends the latched message right behind its
+    header: delivered to no callback, it was gone. rospy keeps the newest message of each
+    latched connection and gives it to callbacks added later; so does orchestra now, once."""
+    from orchestra.node.msg import get_message_class
+    from orchestra.node.topics import InConnection, Subscription
+
+    string = get_message_class("std_msgs/String")
+    sub = Subscription(None, "/mux/selected", string, 10)
+    conn = InConnection(sub, "http://127.0.0.1:9/")  # never started: the test feeds it
+    conn.header = {"latching": "1", "callerid": "/mux", "md5sum": string._md5sum}
+    sub.connections[conn.uri] = conn
+    sub.deliver_raw(bytes(string(data="/a").serialize_bytes()), conn.header, conn.uri, conn)
+    got = []
+    sub.add_callback(lambda m: got.append(m.data), None, string)
+    assert got == ["/a"]
+    sub.deliver_raw(bytes(string(data="/b").serialize_bytes()), conn.header, conn.uri, conn)
+    assert got == ["/a", "/b"]
+    later = []
+    sub.add_callback(lambda m, tag: later.append((tag, m.data)), "late", string)
+    assert later == [("late", "/b")] and got == ["/a", "/b"]
+    # a publisher that does not latch leaves nothing to replay
+    plain = Subscription(None, "/chatter", string, 10)
+    other = InConnection(plain, "http://127.0.0.1:9/")
+    other.header = {"latching": "0"}
+    plain.connections[other.uri] = other
+    plain.deliver_raw(bytes(string(data="x").serialize_bytes()), other.header, other.uri, None)
+    plain.add_callback(lambda m: later.append(m.data), None, string)
+    assert later == [("late", "/b")]
+
+
+LATCHED_TWICE = """
+import json, threading, time
+import orchestra.node as rospy
+from orchestra.node.msg import get_message_class
+S = get_message_class("std_msgs/String")
+rospy.init_node("latch_twice")
+pub = rospy.Publisher("/latched", S, latch=True, queue_size=1)
+pub.publish(S(data="kept"))
+got, first, second = [], threading.Event(), threading.Event()
+rospy.Subscriber("/latched", S, lambda m: (got.append(["a", m.data]), first.set()))
+first.wait(10)
+rospy.Subscriber("/latched", S, lambda m: (got.append(["b", m.data]), second.set()))
+second.wait(5)
+time.sleep(0.2)
+print(json.dumps(got), flush=True)
+"""
+
+
+def test_a_second_subscriber_to_a_latched_topic_gets_the_latched_message(master, tmp_path):
+    """rospy gives a new Subscriber on an already connected latched topic the latched
+    message at once; orchestra shared the connection but gave the new callback nothing."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    script = tmp_path / "latch_twice.py"
+    script.write_text(LATCHED_TWICE)
+    env = dict(os.environ, ROS_MASTER_URI=master.uri, PYTHONUNBUFFERED="1")
+    done = subprocess.run([sys.executable, str(script)], env=env, capture_output=True,
+                          text=True, timeout=25)
+    assert done.returncode == 0, done.stderr
+    assert json.loads(done.stdout) == [["a", "kept"], ["b", "kept"]]

@@ -376,7 +376,9 @@ def _strify(value: Any, indent: str, slot_type: str = "") -> str:
             return "[]"
         first = value[0]
         if isinstance(first, str):
-            return yaml.dump(list(value), width=float("inf")).rstrip("\n")
+            # genpy: a YAML block list, one "- item" line per string at this field's indent
+            text = yaml.dump(list(value), default_flow_style=False, width=float("inf"))
+            return "\n" + "\n".join(indent + line for line in text.splitlines())
         if isinstance(first, (int, float, bool)):
             return str(list(value))
         prefix = indent + "- "

@@ -243,6 +243,9 @@ class InConnection:
         self.bytes_received = 0
         self.messages_received = 0
         self.drops = 0
+        #: the newest message of a latched publisher (``latching: 1``), replayed to callbacks
+        #: added after it arrived, as rospy does (its #1852)
+        self.latched: bytes | None = None
         self.id = next(OutConnection._ids)
         self.thread = threading.Thread(target=self._run, daemon=True,
                                        name=f"sub{subscription.topic}<-{publisher_uri}")
@@ -351,10 +354,11 @@ class InConnection:
             if keep and len(frames) > keep:
                 self.drops += len(frames) - keep
                 frames = frames[-keep:]
+            latching = header.get("latching") == "1"
             for data in frames:
                 self.bytes_received += len(data) + 4
                 self.messages_received += 1
-                sub.deliver_raw(data, header, self.uri)
+                sub.deliver_raw(data, header, self.uri, self if latching else None)
 
 
 class _Refused(Exception):
@@ -371,7 +375,8 @@ class Subscription:
         self.msg_class = msg_class
         self.queue_size = queue_size or 0
         self.lock = threading.Lock()
-        self.callback_lock = threading.Lock()
+        # held while callbacks run; re-entrant so a callback may subscribe to its own topic
+        self.callback_lock = threading.RLock()
         self.callbacks: list[tuple[Callable, Any, type[Message]]] = []
         self.connections: dict[str, InConnection] = {}
         self.closed = False
@@ -381,10 +386,22 @@ class Subscription:
         return self.msg_class._type
 
     def add_callback(self, cb: Callable, cb_args: Any, cls: type[Message]) -> None:
-        with self.lock:
-            self.callbacks = self.callbacks + [(cb, cb_args, cls)]
-            if self.msg_class is AnyMsg and cls is not AnyMsg:
-                self.msg_class = cls  # connections made from now on check the real md5
+        """Add a callback; it is first given the newest message of each latched publisher
+        already received (rospy's rule), then every message that arrives.
+
+        The connection threads connect as soon as the master answers, before the Subscriber
+        handle adds its callback: a fast latched publisher (roscpp sends right after the
+        header) would otherwise deliver to nobody. Holding ``callback_lock`` while adding and
+        replaying makes each latched message reach the new callback exactly once."""
+        with self.callback_lock:
+            with self.lock:
+                self.callbacks = self.callbacks + [(cb, cb_args, cls)]
+                if self.msg_class is AnyMsg and cls is not AnyMsg:
+                    self.msg_class = cls  # connections made from now on check the real md5
+                latched = [(c.latched, c.header, c.uri) for c in self.connections.values()
+                           if c.latched is not None]
+            for data, header, origin in latched:
+                self._dispatch(data, header, origin, [(cb, cb_args, cls)])
 
     def remove_callback(self, cb: Callable, cb_args: Any) -> int:
         with self.lock:
@@ -394,29 +411,38 @@ class Subscription:
                     break
             return len(self.callbacks)
 
-    def deliver_raw(self, data: bytes, header: dict[str, str], origin: str) -> None:
-        """Decode once per message class the callbacks asked for, then call them in order."""
-        decoded: dict[type, Message | None] = {}
+    def deliver_raw(self, data: bytes, header: dict[str, str], origin: str,
+                    latched_on: "InConnection | None" = None) -> None:
+        """Decode once per message class the callbacks asked for, then call them in order.
+        ``latched_on``: the connection of a latched publisher, which keeps the message for
+        callbacks added later."""
         with self.callback_lock:
-            for cb, args, cls in self.callbacks:
-                if cls not in decoded:
-                    try:
-                        msg = AnyMsg(data) if cls is AnyMsg else cls.deserialize_bytes(data)
-                        msg._connection_header = header
-                    except ROSException as exc:
-                        log.error("bad message on %s from %s: %s", self.topic, origin, exc)
-                        msg = None
-                    decoded[cls] = msg
-                msg = decoded[cls]
-                if msg is None:
-                    continue
+            if latched_on is not None:
+                latched_on.latched = data
+            self._dispatch(data, header, origin, self.callbacks)
+
+    def _dispatch(self, data: bytes, header: dict[str, str], origin: str,
+                  callbacks: list[tuple[Callable, Any, type[Message]]]) -> None:
+        decoded: dict[type, Message | None] = {}
+        for cb, args, cls in callbacks:
+            if cls not in decoded:
                 try:
-                    if args is None:
-                        cb(msg)
-                    else:
-                        cb(msg, args)
-                except Exception:  # a user callback must not kill the connection
-                    log.exception("error in callback for %s", self.topic)
+                    msg = AnyMsg(data) if cls is AnyMsg else cls.deserialize_bytes(data)
+                    msg._connection_header = header
+                except ROSException as exc:
+                    log.error("bad message on %s from %s: %s", self.topic, origin, exc)
+                    msg = None
+                decoded[cls] = msg
+            msg = decoded[cls]
+            if msg is None:
+                continue
+            try:
+                if args is None:
+                    cb(msg)
+                else:
+                    cb(msg, args)
+            except Exception:  # a user callback must not kill the connection
+                log.exception("error in callback for %s", self.topic)
 
     def update_publishers(self, uris: list[str], additive: bool = False) -> None:
         """Connect to listed publishers we lack, drop those no longer listed (idempotent).
