@@ -14,6 +14,7 @@ one way and fails the other points at orchestra, not at a difference in the test
          call SERVICE TYPE YAML... [--persistent]   one call per YAML word
          params                       report ~private / relative / searched params
          watch KEY                    print get_param_cached(KEY) each time it changes
+         log TEXT                     loginfo/logwarn TEXT every 0.1 s (TEXT n / TEXT warn n)
 
 Everything it sees is printed as one JSON line (``{"ready": ...}`` first).
 Remaps and ``_param:=value`` words after the arguments are honoured (rospy's rules).
@@ -98,7 +99,9 @@ def run_sub(topic, type_name):
 
     def callback(msg):
         header = getattr(msg, "_connection_header", None) or {}
-        emit(msg=plain(msg), callerid=header.get("callerid"), latching=header.get("latching"))
+        emit(msg=plain(msg), callerid=header.get("callerid"), latching=header.get("latching"),
+             type=header.get("type"), md5sum=header.get("md5sum"),
+             definition=header.get("message_definition"))
 
     rospy.init_node(opts.name, anonymous=opts.anonymous)
     sub = rospy.Subscriber(topic, cls, callback)
@@ -170,6 +173,17 @@ def run_watch(key):
         time.sleep(0.02)
 
 
+def run_log(text):
+    rospy.init_node(opts.name, anonymous=opts.anonymous)
+    emit(ready=rospy.get_name())
+    sent = 0
+    while not rospy.is_shutdown():
+        rospy.loginfo("%s %d", text, sent)
+        rospy.logwarn("%s warn %d", text, sent)
+        sent += 1
+        time.sleep(0.1)
+
+
 MODES = {"pub": run_pub, "sub": run_sub, "serve": run_serve, "call": run_call,
-         "params": run_params, "watch": run_watch}
+         "params": run_params, "watch": run_watch, "log": run_log}
 MODES[opts.mode](*opts.args)
