@@ -108,9 +108,11 @@ def test_sigkilled_orchestra_launch_leaves_no_node_or_grandchild(launch_env):
 
 DETACHER = """#!/bin/sh
 # a node that starts a helper in a session of its own (out of reach of its process group),
-# records both pids, then waits -- or, with "exit", leaves the helper behind at once
-setsid sleep 1000 &
-echo "$$ $!" > "$PIDS_DIR/$1"
+# records both pids once the helper is in its session, then waits -- or, with "exit",
+# leaves the helper behind at once
+setsid sh -c 'echo $$ > "$0"; exec sleep 1000' "$PIDS_DIR/$1.helper" &
+while [ ! -s "$PIDS_DIR/$1.helper" ]; do sleep 0.05; done
+echo "$$ $(cat "$PIDS_DIR/$1.helper")" > "$PIDS_DIR/$1"
 [ "$2" = exit ] && exit 0
 trap 'exit 0' INT TERM
 wait
