@@ -26,7 +26,7 @@ import pytest
 import yaml
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
-from harness import NodeProcess, wait_for  # noqa: E402
+from harness import NodeProcess, ProcessGroup, wait_for  # noqa: E402
 
 
 ROS_PYTHON = "/usr/bin/python3"
@@ -66,17 +66,16 @@ def free_port() -> int:
         return sock.getsockname()[1]
 
 
-class Side:
+class Side(ProcessGroup):
     """Processes of both kinds against one master; ``close()`` kills what is left."""
 
     def __init__(self, master_uri: str, ros_home: Path, package_path: str = ""):
-        self.master_uri = master_uri
+        super().__init__(master_uri)
         common = {"ROS_MASTER_URI": master_uri, "ROS_HOME": str(ros_home),
                   "ROS_PACKAGE_PATH": package_path}
         self.ros_env = _ros_env(common)
         self.orch_env = dict(os.environ, PYTHONUNBUFFERED="1", **common)
         self.orch_env.pop("ROS_NAMESPACE", None)
-        self.procs: list[NodeProcess] = []
 
     def rospy(self, *args: str, env: dict[str, str] | None = None) -> NodeProcess:
         """``peer.py`` as a real rospy node."""
@@ -124,23 +123,7 @@ class Side:
     def background_tool(self, *argv: str) -> NodeProcess:
         return self._start([ROS_PYTHON, f"/usr/bin/{argv[0]}", *argv[1:]], self.ros_env)
 
-    def _start(self, argv: list[str], env: dict[str, str]) -> NodeProcess:
-        proc = NodeProcess(argv, env)
-        self.procs.append(proc)
-        return proc
 
-    def master(self) -> xmlrpc.client.ServerProxy:
-        return xmlrpc.client.ServerProxy(self.master_uri)
-
-    def close(self) -> None:
-        for proc in self.procs:
-            proc.signal(signal.SIGINT)
-        deadline = time.monotonic() + 3
-        for proc in self.procs:
-            try:
-                proc.proc.wait(max(0.1, deadline - time.monotonic()))
-            except subprocess.TimeoutExpired:
-                proc.kill()
 
 
 @pytest.fixture

@@ -22,14 +22,13 @@ import signal
 import socket
 import subprocess
 import sys
-import time
 import xmlrpc.client
 from pathlib import Path
 
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
-from harness import NodeProcess, wait_for  # noqa: E402
+from harness import NodeProcess, ProcessGroup, wait_for  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
@@ -98,14 +97,13 @@ def orch_env(master_uri: str, ros_home: Path) -> dict[str, str]:
     return env
 
 
-class Graph:
+class Graph(ProcessGroup):
     """roscpp programs and orchestra nodes against one master; ``close()`` kills what is left."""
 
     def __init__(self, master_uri: str, ros_home: Path):
-        self.master_uri = master_uri
+        super().__init__(master_uri)
         self.cpp_env = cpp_env(master_uri, ros_home)
         self.orch_env = orch_env(master_uri, ros_home)
-        self.procs: list[NodeProcess] = []
 
     def cpp(self, exe: str, *args: str) -> NodeProcess:
         return self._start([exe, *args], self.cpp_env)
@@ -141,13 +139,6 @@ class Graph:
             results.append(subprocess.CompletedProcess(argv, proc.returncode, out, err))
         return results
 
-    def _start(self, argv: list[str], env: dict[str, str]) -> NodeProcess:
-        proc = NodeProcess(argv, env)
-        self.procs.append(proc)
-        return proc
-
-    def master(self) -> xmlrpc.client.ServerProxy:
-        return xmlrpc.client.ServerProxy(self.master_uri)
 
     def registered(self, node: str) -> bool:
         return self.master().lookupNode("/probe", node)[0] == 1
@@ -157,15 +148,6 @@ class Graph:
         lists = self.master().getSystemState("/probe")[2]
         return tuple({name: set(nodes) for name, nodes in rows} for rows in lists)
 
-    def close(self) -> None:
-        for proc in self.procs:
-            proc.signal(signal.SIGINT)
-        deadline = time.monotonic() + 3
-        for proc in self.procs:
-            try:
-                proc.proc.wait(max(0.1, deadline - time.monotonic()))
-            except subprocess.TimeoutExpired:
-                proc.kill()
 
 
 @pytest.fixture

@@ -101,25 +101,18 @@ class NodeProcess:
             pass
 
 
-class Nodes:
-    """Starts fixture node scripts against one master; ``close()`` kills what is left."""
+class ProcessGroup:
+    """Node processes started against one master; ``close()`` stops them, kills stragglers."""
 
-    def __init__(self, master_uri: str, package_path: Path):
+    #: what ``close()`` sends first; what is still running 3 s later is killed
+    stop_signal = signal.SIGINT
+
+    def __init__(self, master_uri: str):
         self.master_uri = master_uri
-        self.env = dict(os.environ, ROS_MASTER_URI=master_uri,
-                        ROS_PACKAGE_PATH=str(package_path), PYTHONUNBUFFERED="1")
-        self.env.pop("ROS_NAMESPACE", None)
         self.procs: list[NodeProcess] = []
 
-    def start(self, script: str, *args: str, env: dict[str, str] | None = None) -> NodeProcess:
-        argv = [sys.executable, str(HERE / script), *args]
-        proc = NodeProcess(argv, dict(self.env, **(env or {})))
-        self.procs.append(proc)
-        return proc
-
-    def start_orchestra(self, *args: str) -> NodeProcess:
-        """A long-running ``orchestra ...`` command (e.g. ``topic pub -r``)."""
-        proc = NodeProcess([sys.executable, "-m", "orchestra", *args], dict(self.env))
+    def _start(self, argv: list[str], env: dict[str, str]) -> NodeProcess:
+        proc = NodeProcess(argv, env)
         self.procs.append(proc)
         return proc
 
@@ -129,12 +122,33 @@ class Nodes:
     def close(self) -> None:
         for proc in self.procs:
             if proc.proc.poll() is None:
-                proc.signal(signal.SIGTERM)
+                proc.signal(self.stop_signal)
+        deadline = time.monotonic() + 3
         for proc in self.procs:
             try:
-                proc.proc.wait(3)
+                proc.proc.wait(max(0.1, deadline - time.monotonic()))
             except subprocess.TimeoutExpired:
                 proc.kill()
+
+
+class Nodes(ProcessGroup):
+    """Starts fixture node scripts against one master; ``close()`` kills what is left."""
+
+    stop_signal = signal.SIGTERM
+
+    def __init__(self, master_uri: str, package_path: Path):
+        super().__init__(master_uri)
+        self.env = dict(os.environ, ROS_MASTER_URI=master_uri,
+                        ROS_PACKAGE_PATH=str(package_path), PYTHONUNBUFFERED="1")
+        self.env.pop("ROS_NAMESPACE", None)
+
+    def start(self, script: str, *args: str, env: dict[str, str] | None = None) -> NodeProcess:
+        return self._start([sys.executable, str(HERE / script), *args],
+                           dict(self.env, **(env or {})))
+
+    def start_orchestra(self, *args: str) -> NodeProcess:
+        """A long-running ``orchestra ...`` command (e.g. ``topic pub -r``)."""
+        return self._start([sys.executable, "-m", "orchestra", *args], dict(self.env))
 
 
 def wait_for(predicate, timeout: float = 10.0, interval: float = 0.05):
