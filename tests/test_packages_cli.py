@@ -202,22 +202,26 @@ def test_pkg_show_prints_manifest_metadata_and_dependencies(env, tmp_path):
     assert "no <maintainer>" in proc.stderr
 
 
+def only_package_path(monkeypatch, tmp_path, share) -> None:
+    """ROS_PACKAGE_PATH=share and nothing else to find packages by (fresh index, cwd, home)."""
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(share))
+    monkeypatch.setenv("ROS_HOME", str(tmp_path / "rh"))
+    monkeypatch.delenv("CMAKE_PREFIX_PATH", raising=False)
+    monkeypatch.chdir(tmp_path)
+    reset_index()
+
+
 def test_install_space_package_brings_its_lib_dir_without_cmake_prefix_path(tmp_path, monkeypatch):
     prefix = tmp_path / "opt_ros"
     (prefix / "share").mkdir(parents=True)
     (prefix / ".catkin").write_text("")
     package(prefix / "share", "installed")
     binary = script(prefix / "lib" / "installed" / "tool")
-    monkeypatch.setenv("ROS_PACKAGE_PATH", str(prefix / "share"))
-    monkeypatch.setenv("ROS_HOME", str(tmp_path / "rh"))
-    monkeypatch.delenv("CMAKE_PREFIX_PATH", raising=False)
-    monkeypatch.chdir(tmp_path)
-    reset_index()
+    only_package_path(monkeypatch, tmp_path, prefix / "share")
     try:
         assert find_executable("installed", "tool") == str(binary)
     finally:
         reset_index()
-
 
 
 @pytest.mark.parametrize("system", [True, False])
@@ -232,11 +236,7 @@ def test_debian_system_package_brings_its_lib_dir_without_a_catkin_marker(
     package(prefix / "share", "topic_tools")
     binary = script(prefix / "lib" / "topic_tools" / "relay")
     monkeypatch.setattr(executables, "SYSTEM_PREFIXES", (str(prefix),) if system else ())
-    monkeypatch.setenv("ROS_PACKAGE_PATH", str(prefix / "share"))
-    monkeypatch.setenv("ROS_HOME", str(tmp_path / "rh"))
-    monkeypatch.delenv("CMAKE_PREFIX_PATH", raising=False)
-    monkeypatch.chdir(tmp_path)
-    reset_index()
+    only_package_path(monkeypatch, tmp_path, prefix / "share")
     try:
         if system:
             assert find_executable("topic_tools", "relay") == str(binary)
