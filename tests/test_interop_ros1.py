@@ -493,7 +493,8 @@ def test_real_rosservice_lists_and_calls_orchestra_services(side):
         ("rosservice", "call", "/set_bool", "data: false"))
     assert listed.returncode == 0, listed.stderr
     assert "/set_bool" in listed.stdout.split()
-    assert "/server/get_loggers" not in listed.stdout  # orchestra offers no logger services
+    # every node offers the logger services, as rospy's do (tests/test_node_loggers.py)
+    assert {"/server/get_loggers", "/server/set_logger_level"} <= set(listed.stdout.split())
     assert typ.stdout == "std_srvs/SetBool\n"
     assert call.returncode == 0, call.stderr
     assert re.fullmatch(r'success: True\nmessage: "orchestra call [12]"\n', call.stdout)

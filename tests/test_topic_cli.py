@@ -114,7 +114,9 @@ def test_topic_hz_reports_the_average_rate(nodes):
 
 def test_service_list_type_info_and_call(nodes):
     nodes.start("adder.py", "add").ready()
-    assert orchestra(nodes, "service", "list").stdout.split() == ["/add"]
+    # with the logger services every node offers (tests/test_node_loggers.py)
+    assert orchestra(nodes, "service", "list").stdout.split() == [
+        "/add", "/adder/get_loggers", "/adder/set_logger_level"]
     assert orchestra(nodes, "service", "type", "/add").stdout == "test_msgs/AddTwoInts\n"
     info = orchestra(nodes, "service", "info", "add").stdout
     assert "Node: /adder\nURI: rosrpc://127.0.0.1:" in info and "Args: a b" in info

@@ -18,6 +18,7 @@ import yaml
 from orchestra.errors import OrchestraError
 from orchestra.node import introspect
 from orchestra.node.exceptions import ROSException
+from orchestra.node.loggers import LEVEL_NAMES
 
 CLI_NODE = "orchestra_cli"
 
@@ -102,7 +103,8 @@ def _stop_cli_node(reason: str) -> None:
 
 @click.group()
 def node() -> None:
-    """Running nodes: list, info, kill, ping, cleanup (like rosnode)."""
+    """Running nodes: list, info, kill, ping, cleanup (like rosnode); loggers and
+    set-logger-level (like rosconsole list/get/set)."""
 
 
 @node.command("list")
@@ -236,6 +238,69 @@ def node_cleanup(yes: bool) -> None:
     for name in dead:
         introspect.purge_node(uri, state, name)
         click.echo(f"unregistered {name}")
+
+
+def _node_loggers(uri_master: str, node_name: str) -> list[tuple[str, str]]:
+    """(logger, level) pairs from the node's ``~get_loggers`` service, in its order."""
+    from orchestra.node.msg import get_service_class
+    cls = get_service_class("roscpp/GetLoggers")
+    name = _logger_service(uri_master, node_name, "get_loggers", cls)
+    response = _call_service(uri_master, name, cls, cls._request_class())
+    return [(logger.name, logger.level) for logger in response.loggers]
+
+
+def _logger_service(uri_master: str, node_name: str, suffix: str, cls) -> str:
+    """``NODE/suffix``, checked to be there and of the expected type (rosconsole's check)."""
+    name = f"{node_name}/{suffix}"
+    try:
+        header = introspect.service_header(uri_master, name)
+    except introspect.GraphError as exc:
+        raise introspect.GraphError(f"node [{node_name}] does not exist or offers no logger "
+                                    f"services: {exc}") from None
+    if header.get("md5sum") not in (None, "*", cls._md5sum):
+        raise CommandFailed(f"service [{name}] is not a {cls._type} "
+                            f"({header.get('type', 'unknown type')})")
+    return name
+
+
+@node.command("loggers")
+@click.argument("name")
+@click.argument("logger", required=False)
+@click.option("-l", "--levels", is_flag=True, help="Print each logger's level after its name.")
+def node_loggers(name: str, logger: str | None, levels: bool) -> None:
+    """Print the loggers of node NAME, one per line (as rosconsole list); with LOGGER, print
+    that logger's level (as rosconsole get)."""
+    uri_master = _master_uri()
+    name = _global(name)
+    loggers = _node_loggers(uri_master, name)
+    if logger is not None:
+        table = dict(loggers)
+        if logger not in table:
+            raise OrchestraError(f"node {name} does not contain logger {logger}")
+        click.echo(table[logger])
+        return
+    width = max((len(n) for n, _ in loggers), default=0)
+    for logger_name, level in loggers:
+        click.echo(f"{logger_name:<{width}}  {level}" if levels else logger_name)
+
+
+@node.command("set-logger-level")
+@click.argument("name")
+@click.argument("logger")
+@click.argument("level", metavar="LEVEL",
+                type=click.Choice(LEVEL_NAMES, case_sensitive=False))
+def node_set_logger_level(name: str, logger: str, level: str) -> None:
+    """Set LOGGER of node NAME to LEVEL (debug, info, warn, error or fatal) at once, as
+    rosconsole set does."""
+    from orchestra.node.msg import get_service_class
+    uri_master = _master_uri()
+    name = _global(name)
+    if logger not in dict(_node_loggers(uri_master, name)):
+        raise OrchestraError(f"node {name} does not contain logger {logger}")
+    cls = get_service_class("roscpp/SetLoggerLevel")
+    service = _logger_service(uri_master, name, "set_logger_level", cls)
+    _call_service(uri_master, service, cls, cls._request_class(logger=logger,
+                                                               level=level.lower()))
 
 
 # --- topic --------------------------------------------------------------------------------------
@@ -602,8 +667,6 @@ def service_info(name: str) -> None:
 @click.argument("values", nargs=-1)
 def service_call(name: str, values: tuple[str, ...]) -> None:
     """Call NAME with a request built from YAML VALUES; print the response as YAML."""
-    from orchestra.node import tcpros
-    from orchestra.node.exceptions import TransportException
     from orchestra.node.msg import MessageNotFound, get_service_class, to_yaml_text
     uri_master = _master_uri()
     name = _global(name)
@@ -618,11 +681,20 @@ def service_call(name: str, values: tuple[str, ...]) -> None:
                              f"(md5 {header.get('md5sum')}, ours {cls._md5sum})")
     request = _fill(cls._request_class, _parse_yaml(values, srv_type + " request"),
                     srv_type + " request")
+    # an empty response prints an empty line, as rosservice does
+    click.echo(to_yaml_text(_call_service(uri_master, name, cls, request)))
+
+
+def _call_service(uri_master: str, name: str, cls, request):
+    """One call of the service ``name`` over a connection of its own (no node needed, as
+    rosservice call); a refusal or an error response is CommandFailed (exit 1)."""
+    from orchestra.node import tcpros
+    from orchestra.node.exceptions import TransportException
     host, port = tcpros.parse_rosrpc_uri(introspect.service_uri(uri_master, name))
     try:
         with tcpros.connect(host, port) as sock:
             tcpros.write_header(sock, {"callerid": introspect.CALLER, "service": name,
-                                       "md5sum": cls._md5sum, "type": srv_type})
+                                       "md5sum": cls._md5sum, "type": cls._type})
             reply_header = tcpros.read_header(sock)
             if "error" in reply_header:
                 raise CommandFailed(f"service [{name}] refused the call: {reply_header['error']}")
@@ -633,8 +705,7 @@ def service_call(name: str, values: tuple[str, ...]) -> None:
     if not ok:
         raise CommandFailed(f"service [{name}] responded with an error: "
                             f"{body.decode('utf-8', 'replace')}")
-    # an empty response prints an empty line, as rosservice does
-    click.echo(to_yaml_text(cls._response_class.deserialize_bytes(body)))
+    return cls._response_class.deserialize_bytes(body)
 
 
 # --- graph -------------------------------------------------------------------------------------

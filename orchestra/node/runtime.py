@@ -364,6 +364,8 @@ def init_node(name: str, argv: list[str] | None = None, anonymous: bool = False,
         runtime.rosout = _make_rosout()
     if not disable_rostime and _param_is_true(runtime, "/use_sim_time"):
         runtime.clock_sub = _follow_clock()
+    # as rospy: every node offers them (disable_rosout or not; rospy has no flag for them)
+    runtime.logger_services = _offer_logger_services()
 
 
 def _param_is_true(runtime: NodeRuntime, key: str) -> bool:
@@ -573,6 +575,20 @@ class _ConsoleHandler(logging.Handler):
             pass
 
 
+def _explicitly_lowered(record: logging.LogRecord) -> bool:
+    """Warnings and worse from orchestra's library; lower levels only from a logger whose
+    own level, or an ancestor's below the root, was set (``~set_logger_level``, or the
+    script): ``set_logger_level /node orchestra.node.topics debug`` shows its debug lines."""
+    if record.levelno >= logging.WARNING:
+        return True
+    logger = logging.getLogger(record.name)
+    while logger is not None and logger.parent is not None:
+        if logger.level != logging.NOTSET:
+            return True
+        logger = logger.parent
+    return False
+
+
 def _setup_logging(level: int | None) -> None:
     if not any(isinstance(h, _ConsoleHandler) for h in _user_log.handlers):
         _user_log.addHandler(_ConsoleHandler())
@@ -581,10 +597,23 @@ def _setup_logging(level: int | None) -> None:
         # a node script that configured no logging still shows our warnings (refused
         # connections, handler errors) in the same console format as its own log lines
         handler = _ConsoleHandler()
-        handler.setLevel(logging.WARNING)
+        handler.addFilter(_explicitly_lowered)
         library.addHandler(handler)
     _user_log.propagate = False
     _user_log.setLevel(level if level is not None and level >= 10 else logging.INFO)
+
+
+def _offer_logger_services() -> list:
+    """``~get_loggers`` and ``~set_logger_level`` (orchestra/node/loggers.py)."""
+    from orchestra.node import loggers
+
+    try:
+        return loggers.offer_services()
+    except ROSInterruptException:
+        raise
+    except ROSException as exc:
+        log.warning("no logger services: %s", exc)
+        return []
 
 
 def _make_rosout():
@@ -599,9 +628,12 @@ def _make_rosout():
 
 
 def _log(level: int, msg: Any, args: tuple) -> None:
+    # below the level of the logger "rosout" (init_node's log_level, or ~set_logger_level
+    # since) a message is neither printed nor published, as in rospy
+    if not _user_log.isEnabledFor(level):
+        return
     text = str(msg) % args if args else str(msg)
-    if _user_log.isEnabledFor(level):
-        _user_log.log(level, text)
+    _user_log.log(level, text)
     rt = _runtime
     pub = getattr(rt, "rosout", None) if rt is not None else None
     if pub is None or rt.is_shutdown():
