@@ -446,7 +446,8 @@ def test_orchestra_launch_runs_debian_topic_tools_relay_and_cpp_rosout(tmp_path,
             pid = xmlrpc.client.ServerProxy(
                 master.lookupNode("/probe", node)[2]).getPid("/probe")[2]
             assert os.readlink(f"/proc/{pid}/exe") == exe, node
-        assert group.state()[1]["/remapped/in"] == {"/robot/relay"}
+        # the node is known once its first registration lands; its subscription may follow
+        wait_for(lambda: group.state()[1].get("/remapped/in") == {"/robot/relay"}, timeout=10)
         group.orch("--name", "talker", "pub", "/remapped/in", "std_msgs/String", "data: via launch")
         sub = group.orch("--name", "listener", "sub", "/robot/out", "std_msgs/String")
         got = sub.expect(lambda d: "msg" in d, 15)
