@@ -26,10 +26,9 @@ import pytest
 import yaml
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
-from harness import NodeProcess, ProcessGroup, wait_for  # noqa: E402
+from harness import ROS_PYTHON, NodeProcess, ProcessGroup, wait_for  # noqa: E402
 
 
-ROS_PYTHON = "/usr/bin/python3"
 HERE = Path(__file__).resolve().parent
 PEER = HERE / "ros1_nodes" / "peer.py"
 REPO = HERE.parent
@@ -94,31 +93,6 @@ class Side(ProcessGroup):
     def orchestra(self, *args: str, timeout: float = 20) -> subprocess.CompletedProcess:
         return subprocess.run([sys.executable, "-m", "orchestra", *args], env=self.orch_env,
                               capture_output=True, text=True, timeout=timeout)
-
-    def run_all(self, *commands: tuple[str, ...], timeout: float = 20
-                ) -> list[subprocess.CompletedProcess]:
-        """Several commands at once (each a real tool, or ``orchestra ...``), in order.
-
-        Independent look-ups run concurrently: a real ROS tool costs half a second of
-        interpreter start-up, and the module must stay fast.
-        """
-        procs = []
-        for argv in commands:
-            if argv[0] == "orchestra":
-                full, env = [sys.executable, "-m", "orchestra", *argv[1:]], self.orch_env
-            else:
-                full, env = [ROS_PYTHON, f"/usr/bin/{argv[0]}", *argv[1:]], self.ros_env
-            procs.append(subprocess.Popen(full, env=env, stdout=subprocess.PIPE,
-                                          stderr=subprocess.PIPE, text=True))
-        results = []
-        for argv, proc in zip(commands, procs):
-            try:
-                out, err = proc.communicate(timeout=timeout)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                out, err = proc.communicate()
-            results.append(subprocess.CompletedProcess(argv, proc.returncode, out, err))
-        return results
 
     def background_tool(self, *argv: str) -> NodeProcess:
         return self._start([ROS_PYTHON, f"/usr/bin/{argv[0]}", *argv[1:]], self.ros_env)

@@ -28,7 +28,7 @@ from pathlib import Path
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
-from harness import NodeProcess, ProcessGroup, wait_for  # noqa: E402
+from harness import ROS_PYTHON, NodeProcess, ProcessGroup, wait_for  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
@@ -41,7 +41,6 @@ ROSOUT = "/usr/lib/rosout/rosout"               # Debian: rosout
 STATIC_TF = "/usr/lib/tf2_ros/static_transform_publisher"  # Debian: tf2-tools
 TOPIC_TOOLS = Path("/usr/share/topic_tools")    # package.xml: libtopic-tools-dev
 MUX_SRV = TOPIC_TOOLS / "srv" / "MuxSelect.srv"  # ros-topic-tools-srvs
-ROS_PYTHON = "/usr/bin/python3"
 
 
 def _absent(*paths: str | Path) -> str | None:
@@ -104,6 +103,9 @@ class Graph(ProcessGroup):
         super().__init__(master_uri)
         self.cpp_env = cpp_env(master_uri, ros_home)
         self.orch_env = orch_env(master_uri, ros_home)
+        # Debian's Python tools (rosnode, rosservice ...) beside the C++ programs
+        self.ros_env = {k: v for k, v in self.cpp_env.items()
+                        if not k.startswith(("PYTHON", "VIRTUAL_ENV"))}
 
     def cpp(self, exe: str, *args: str) -> NodeProcess:
         return self._start([exe, *args], self.cpp_env)
@@ -115,30 +117,6 @@ class Graph(ProcessGroup):
     def orchestra(self, *args: str, timeout: float = 20) -> subprocess.CompletedProcess:
         return subprocess.run([sys.executable, "-m", "orchestra", *args], env=self.orch_env,
                               capture_output=True, text=True, timeout=timeout)
-
-    def run_all(self, *commands: tuple[str, ...], timeout: float = 20
-                ) -> list[subprocess.CompletedProcess]:
-        """``orchestra ...`` commands and real ROS tools (``rosnode ...``), concurrently."""
-        ros_env = {k: v for k, v in self.cpp_env.items()
-                   if not k.startswith(("PYTHON", "VIRTUAL_ENV"))}
-        procs = []
-        for argv in commands:
-            if argv[0] == "orchestra":
-                full, env = [sys.executable, "-m", "orchestra", *argv[1:]], self.orch_env
-            else:
-                full, env = [ROS_PYTHON, f"/usr/bin/{argv[0]}", *argv[1:]], ros_env
-            procs.append(subprocess.Popen(full, env=env, stdout=subprocess.PIPE,
-                                          stderr=subprocess.PIPE, text=True))
-        results = []
-        for argv, proc in zip(commands, procs):
-            try:
-                out, err = proc.communicate(timeout=timeout)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                out, err = proc.communicate()
-            results.append(subprocess.CompletedProcess(argv, proc.returncode, out, err))
-        return results
-
 
     def registered(self, node: str) -> bool:
         return self.master().lookupNode("/probe", node)[0] == 1

@@ -17,6 +17,7 @@ import pytest
 import yaml
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
+import harness  # noqa: E402
 from harness import wait_for  # noqa: E402
 from test_node_simtime import Driven  # noqa: E402  (a NodeProcess with a stdin pipe)
 
@@ -38,18 +39,8 @@ def start_talker(group, env: dict[str, str], *args: str) -> Driven:
 def run_all(env: dict[str, str], *commands: tuple[str, ...], timeout: float = 30
             ) -> list[subprocess.CompletedProcess]:
     """``orchestra ...`` commands run concurrently (each is an interpreter start-up)."""
-    procs = [subprocess.Popen([sys.executable, "-m", "orchestra", *argv], env=env,
-                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-             for argv in commands]
-    results = []
-    for argv, proc in zip(commands, procs):
-        try:
-            out, err = proc.communicate(timeout=timeout)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            out, err = proc.communicate()
-        results.append(subprocess.CompletedProcess(argv, proc.returncode, out, err))
-    return results
+    return harness.run_all([(argv, [sys.executable, "-m", "orchestra", *argv], env)
+                            for argv in commands], timeout)
 
 
 def orchestra(env: dict[str, str], *args: str) -> subprocess.CompletedProcess:

@@ -101,6 +101,29 @@ class NodeProcess:
             pass
 
 
+ROS_PYTHON = "/usr/bin/python3"   # Debian's Python, where its real ROS 1 tools live
+
+
+def run_all(jobs: list[tuple[tuple[str, ...], list[str], dict[str, str]]], timeout: float = 20
+            ) -> list[subprocess.CompletedProcess]:
+    """Run ``(label, argv, env)`` jobs at once and wait for each (killed after ``timeout``).
+
+    Independent look-ups run concurrently: each is an interpreter start-up (half a second for
+    a real ROS tool), and the modules must stay fast. Results keep the jobs' order and labels.
+    """
+    procs = [subprocess.Popen(argv, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                              text=True) for _, argv, env in jobs]
+    results = []
+    for (label, _, _), proc in zip(jobs, procs):
+        try:
+            out, err = proc.communicate(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            out, err = proc.communicate()
+        results.append(subprocess.CompletedProcess(label, proc.returncode, out, err))
+    return results
+
+
 class ProcessGroup:
     """Node processes started against one master; ``close()`` stops them, kills stragglers."""
 
@@ -118,6 +141,20 @@ class ProcessGroup:
 
     def master(self) -> xmlrpc.client.ServerProxy:
         return xmlrpc.client.ServerProxy(self.master_uri)
+
+    def run_all(self, *commands: tuple[str, ...], timeout: float = 20
+                ) -> list[subprocess.CompletedProcess]:
+        """``orchestra ...`` commands (in ``self.orch_env``) and real ROS tools such as
+        ``rosnode ...`` (Debian's, in ``self.ros_env``), concurrently, results in order."""
+        jobs = []
+        for argv in commands:
+            if argv[0] == "orchestra":
+                jobs.append((argv, [sys.executable, "-m", "orchestra", *argv[1:]],
+                             self.orch_env))
+            else:
+                jobs.append((argv, [ROS_PYTHON, f"/usr/bin/{argv[0]}", *argv[1:]],
+                             self.ros_env))
+        return run_all(jobs, timeout)
 
     def close(self) -> None:
         for proc in self.procs:
