@@ -76,8 +76,60 @@ def test_topic_pub_at_a_rate_streams_messages(nodes):
     pub.kill()
 
 
+def stamps_seen(sub, stamp, count: int = 4) -> list[float]:
+    """The stamps (seconds) of the next ``count`` messages ``sub`` prints."""
+    def seconds(msg):
+        t = stamp(msg)
+        return t["secs"] + t["nsecs"] / 1e9
+    return [seconds(sub.messages(timeout=20)) for _ in range(count)]
+
+
+@pytest.mark.parametrize("type_name,yaml_text,stamp", [
+    ("rosgraph_msgs/Clock", "clock: now", lambda m: m["clock"]),
+    ("std_msgs/Header", "auto", lambda m: m["stamp"]),
+    ("geometry_msgs/PoseStamped", "{header: auto, pose: {position: {x: 1.5}}}",
+     lambda m: m["header"]["stamp"]),
+])
+def test_topic_pub_substitute_keywords_stamps_each_message_now(nodes, type_name, yaml_text,
+                                                                stamp):
+    """rostopic pub -s -r: 'now' / 'auto' evaluated again for every message, on wall time
+    (``rostopic pub -s -r 10 /clock rosgraph_msgs/Clock "clock: now"`` drives /clock)."""
+    sub = nodes.start("sub.py", "stamped", type_name)
+    sub.ready()
+    started = time.time()
+    nodes.start_orchestra("topic", "pub", "-s", "-r", "20", "/stamped", type_name, yaml_text)
+    stamps = stamps_seen(sub, stamp)
+    assert all(a < b for a, b in zip(stamps, stamps[1:])), stamps
+    assert started - 5 < stamps[0] and stamps[-1] < time.time() + 5, (started, stamps)
+    last = sub.messages(timeout=20)
+    if type_name == "geometry_msgs/PoseStamped":
+        assert last["header"]["frame_id"] == "" and last["header"]["seq"] > 0
+        assert last["pose"]["position"]["x"] == 1.5
+    elif type_name == "std_msgs/Header":
+        assert last["frame_id"] == ""
+
+
+def test_topic_pub_without_substitute_keywords_stamps_once_at_start(nodes):
+    """As rostopic: without -s, 'now' and 'auto' are evaluated once, so every message of
+    ``-r`` carries the same (start) time."""
+    sub = nodes.start("sub.py", "stamped", "geometry_msgs/PoseStamped")
+    sub.ready()
+    started = time.time()
+    nodes.start_orchestra("topic", "pub", "-r", "20", "/stamped", "geometry_msgs/PoseStamped",
+                          "{header: auto}")
+    stamps = stamps_seen(sub, lambda m: m["header"]["stamp"])
+    assert len(set(stamps)) == 1 and abs(stamps[0] - started) < 10, (started, stamps)
+
+
 @pytest.mark.parametrize("args,message", [
     (["/x", "std_msgs/String", "{data: [}"], "malformed YAML for std_msgs/String"),
+    (["/c", "rosgraph_msgs/Clock", "clock: later"],
+     "field clock must be {secs, nsecs}, a number or 'now', not 'later'"),
+    (["/c", "rosgraph_msgs/Clock", "-s", "clock: {secs: now}"],
+     "field clock.secs must be an integer, not 'now'"),
+    (["/h", "std_msgs/Header", "now"], "give a mapping of its fields (or 'auto')"),
+    (["/p", "geometry_msgs/PoseStamped", "{header: {stamp: auto}}"],
+     "field header.stamp must be {secs, nsecs}, a number or 'now'"),
     (["/x", "std_msgs/String", "{dat: 1}"], "has no field dat"),
     (["/x", "geometry_msgs/Twist", "{linear: {x: fast}}"], "must be a number"),
     (["/x", "nope_msgs/Nothing", "{}"], "cannot find message type nope_msgs/Nothing"),

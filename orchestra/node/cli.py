@@ -501,14 +501,21 @@ def pick_field(msg, fields: list[str]):
 @click.option("-r", "--rate", type=float, default=None, help="Publish at HZ (not latched).")
 @click.option("-1", "--once", is_flag=True, help="Publish once, let subscribers get it, exit.")
 @click.option("-l", "--latch", is_flag=True, help="Latch (the default without -r).")
+@click.option("-s", "--substitute-keywords", "substitute", is_flag=True,
+              help="With -r: evaluate 'now' and 'auto' again for each message (without it, "
+                   "once at start).")
 @click.option("--wait", "wait_time", type=float, default=3.0, show_default=True,
               help="With -1: longest wait for known subscribers to connect.")
 def topic_pub(name: str, type_name: str, values: tuple[str, ...], rate: float | None,
-              once: bool, latch: bool, wait_time: float) -> None:
-    """Publish a TYPE message built from YAML VALUES on NAME."""
+              once: bool, latch: bool, substitute: bool, wait_time: float) -> None:
+    """Publish a TYPE message built from YAML VALUES on NAME.
+
+    A time field given as 'now' is the current (wall) time, a Header given as 'auto' is one
+    stamped now; both are evaluated once, at start, unless -s asks for each message."""
     name = _global(name)
     cls = _message_class(type_name)
-    msg = _fill(cls, _parse_yaml(values, type_name), type_name)
+    value = _parse_yaml(values, type_name)
+    msg = _fill(cls, value, type_name)
     if rate is not None and rate <= 0:
         raise OrchestraError("--rate must be positive")
     rospy = _start_cli_node()
@@ -531,6 +538,8 @@ def topic_pub(name: str, type_name: str, values: tuple[str, ...], rate: float | 
         else:
             r = rospy.Rate(rate)
             while True:
+                if substitute:  # a fresh message: 'now' and 'auto' evaluated again
+                    msg = _fill(cls, value, type_name)
                 pub.publish(msg)
                 r.sleep()
     except (KeyboardInterrupt, rospy.ROSInterruptException):

@@ -427,12 +427,20 @@ def _fill_field(current: Any, value: Any, base: str, array: int | None, path: st
             unknown = set(value) - {"secs", "nsecs"}
             if unknown:
                 raise FillError(f"field {path}: unknown keys {sorted(unknown)} (secs, nsecs)")
-            return cls(int(value.get("secs", 0)), int(value.get("nsecs", 0)))
+            parts = []
+            for key in ("secs", "nsecs"):
+                try:
+                    parts.append(int(value.get(key, 0)))
+                except (TypeError, ValueError):
+                    raise FillError(f"field {path}.{key} must be an integer, "
+                                    f"not {value[key]!r}") from None
+            return cls(*parts)
         if value == "now" and base == "time":
             return Time.now()
         if isinstance(value, (int, float)) and not isinstance(value, bool):
             return cls.from_sec(value)
-        raise FillError(f"field {path} must be {{secs, nsecs}} or a number")
+        now = ", a number or 'now'" if base == "time" else " or a number"
+        raise FillError(f"field {path} must be {{secs, nsecs}}{now}, not {value!r}")
     if base == "string":
         if not isinstance(value, str):
             if isinstance(value, (dict, list)):
@@ -451,11 +459,6 @@ def _fill_field(current: Any, value: Any, base: str, array: int | None, path: st
         if isinstance(value, bool) or not isinstance(value, int):
             raise FillError(f"field {path} must be an integer, not {value!r}")
         return value
-    if base == "std_msgs/Header" and value == "auto":
-        # rostopic pub's substitution: a header stamped now
-        header = get_message_class(base)()
-        header.stamp = Time.now()
-        return header
     return fill_message(current if isinstance(current, Message) else get_message_class(base)(),
                         value, path)
 
@@ -466,6 +469,11 @@ def fill_message(msg: Message, value: Any, path: str = "") -> Message:
     spec = msg._spec
     fields = spec.fields if spec is not None else ()
     if value is None:
+        return msg
+    if msg._type == "std_msgs/Header" and value == "auto":
+        # rostopic pub's substitution: a header stamped now (seq is the publisher's, frame_id
+        # empty); here also for a whole std_msgs/Header message, which rostopic refuses
+        msg.seq, msg.stamp, msg.frame_id = 0, Time.now(), ""
         return msg
     if isinstance(value, dict):
         by_name = {f.name: f for f in fields}
@@ -489,5 +497,7 @@ def fill_message(msg: Message, value: Any, path: str = "") -> Message:
         f = fields[0]
         setattr(msg, f.name, _fill_field(getattr(msg, f.name), value, f.base, f.array, f.name))
         return msg
-    raise FillError(f"cannot fill {msg._type} from {value!r}: give a mapping of its fields")
+    hint = " (or 'auto')" if msg._type == "std_msgs/Header" else ""
+    raise FillError(f"cannot fill {msg._type} from {value!r}: give a mapping of its "
+                    f"fields{hint}")
 
