@@ -195,6 +195,15 @@ def test_fill_message_from_yaml_shapes():
     assert plain == {"seq": 0, "stamp": {"secs": 0, "nsecs": 0}, "frame_id": "a"}
 
 
+def test_bare_integer_time_is_nanoseconds_as_in_rostopic_and_a_float_is_seconds():
+    Clock = get_message_class("rosgraph_msgs/Clock")
+    assert fill_message(Clock(), {"clock": 5}).clock == Time(0, 5)            # genpy's rule
+    assert fill_message(Clock(), {"clock": 5_000_000_000}).clock == Time(5, 0)
+    assert fill_message(Clock(), {"clock": 5.5}).clock == Time(5, 500_000_000)  # genpy refuses
+    Header = get_message_class("std_msgs/Header")
+    assert fill_message(Header(), {"stamp": 7}).stamp == Time(0, 7)
+
+
 def test_class_from_connection_header_definition_decodes_unknown_types():
     definition = ("uint8 MODE=2\nfoo_msgs/Inner inner\nstring name\n" + "=" * 80 +
                   "\nMSG: foo_msgs/Inner\nint32[] values\n")

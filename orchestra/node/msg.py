@@ -437,8 +437,10 @@ def _fill_field(current: Any, value: Any, base: str, array: int | None, path: st
             return cls(*parts)
         if value == "now" and base == "time":
             return Time.now()
-        if isinstance(value, (int, float)) and not isinstance(value, bool):
-            return cls.from_sec(value)
+        if isinstance(value, int) and not isinstance(value, bool):
+            return cls(0, value)   # as genpy (rostopic pub): a bare integer is nanoseconds
+        if isinstance(value, float):
+            return cls.from_sec(value)   # genpy refuses a float; seconds is what it means
         now = ", a number or 'now'" if base == "time" else " or a number"
         raise FillError(f"field {path} must be {{secs, nsecs}}{now}, not {value!r}")
     if base == "string":
