@@ -1,6 +1,7 @@
 """``orchestra launch FILE`` as a user runs it: signals to orchestra, SIGKILL, exit codes."""
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import socket
@@ -93,17 +94,32 @@ def survivors(pids, limit=5.0) -> list[int]:
     return [p for p in pids if alive(p)]
 
 
-def test_sigkilled_orchestra_launch_leaves_no_node_or_grandchild(launch_env):
-    proc = start(launch_env)
+@contextlib.contextmanager
+def running(launch_env, *extra):
+    """``orchestra launch`` of the test's launch file; killed on the way out if still running."""
+    proc = start(launch_env, *extra)
     try:
+        yield proc
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        if proc.stdout is not None and not proc.stdout.closed:
+            proc.communicate()
+
+
+def finish(proc, sig: int | None = None) -> tuple[str, str]:
+    """Send ``sig`` to orchestra (if given), wait for its exit, return (stdout, stderr)."""
+    if sig is not None:
+        proc.send_signal(sig)
+    return proc.communicate(timeout=30)
+
+
+def test_sigkilled_orchestra_launch_leaves_no_node_or_grandchild(launch_env):
+    with running(launch_env) as proc:
         pids = wait_pids(launch_env, proc)
         proc.kill()
         proc.wait(timeout=10)
         assert survivors(pids) == []
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-        proc.communicate()
 
 
 DETACHER = """#!/bin/sh
@@ -129,47 +145,31 @@ def add_detacher(launch_env, args: str) -> None:
 
 def test_sigkilled_orchestra_leaves_no_grandchild_that_called_setsid(launch_env):
     add_detacher(launch_env, "d")
-    proc = start(launch_env)
-    try:
+    with running(launch_env) as proc:
         node, helper = wait_pids(launch_env, proc, names=("d",))
         assert os.getsid(helper) != os.getsid(node)      # really out of the node's session
         proc.kill()
         proc.wait(timeout=10)
         assert survivors([node, helper]) == []
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-        proc.communicate()
 
 
 def test_stop_ends_what_an_exited_node_left_outside_its_process_group(launch_env):
     add_detacher(launch_env, "d exit")
-    proc = start(launch_env)
-    try:
+    with running(launch_env) as proc:
         node, helper = wait_pids(launch_env, proc, names=("d",))
         assert survivors([node]) == []        # the node is gone: its helper is an orphan
         assert alive(helper)
-        proc.send_signal(signal.SIGINT)
-        out, err = proc.communicate(timeout=30)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.communicate()
+        out, err = finish(proc, signal.SIGINT)
     assert proc.returncode == 0, err
     assert survivors([helper], limit=3) == []
     assert f"{helper} (sleep)" in err and "outside their process groups" in err
 
+
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP, signal.SIGINT])
 def test_stop_signal_to_orchestra_is_a_graceful_stop(launch_env, sig):
-    proc = start(launch_env)
-    try:
+    with running(launch_env) as proc:
         pids = wait_pids(launch_env, proc)
-        proc.send_signal(sig)
-        out, err = proc.communicate(timeout=30)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.communicate()
+        out, err = finish(proc, sig)
     assert proc.returncode == 0, err
     assert survivors(pids, limit=1) == []
     assert f"{signal.Signals(sig).name} received" in err
@@ -180,30 +180,19 @@ def test_stop_signal_to_orchestra_is_a_graceful_stop(launch_env, sig):
 def test_required_node_death_via_cli_exit_code(launch_env):
     Path(launch_env["launch"]).write_text(
         LAUNCH.replace('name="a" args="a"', 'name="a" args="a" required="true"'))
-    proc = start(launch_env)
-    try:
+    with running(launch_env) as proc:
         pids = wait_pids(launch_env, proc)
         os.kill(pids[0], signal.SIGKILL)     # node /a (required) dies
-        out, err = proc.communicate(timeout=30)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.communicate()
+        out, err = finish(proc)
     assert proc.returncode == 1
     assert "required process /a died (killed by SIGKILL)" in err
     assert survivors(pids, limit=2) == []
 
 
 def test_log_files_named_like_roslaunch_with_latest_link(launch_env):
-    proc = start(launch_env)
-    try:
+    with running(launch_env) as proc:
         wait_pids(launch_env, proc)
-        proc.send_signal(signal.SIGINT)
-        proc.communicate(timeout=30)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.communicate()
+        finish(proc, signal.SIGINT)
     latest = launch_env["tmp"] / "home" / "log" / "latest"
     names = sorted(p.name for p in latest.iterdir() if p.name != "rosout.log")
     # output="log" nodes get files; the output="screen" node /g/b does not; /rosout, started
