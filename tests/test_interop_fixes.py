@@ -93,22 +93,17 @@ def test_kill_counts_a_node_that_drops_the_reply_and_goes_silent_as_killed(maste
         slave.close()
 
 
-def test_kill_fails_when_the_node_refuses_the_shutdown(master):
-    slave = _RospyLikeSlave("refuse")
+@pytest.mark.parametrize("behaviour, settle", [
+    ("refuse", None),          # the node refuses the shutdown
+    ("drop_but_live", 0.3),    # the connection drops but the node keeps answering
+])
+def test_kill_fails_when_the_node_did_not_accept_the_shutdown(master, behaviour, settle):
+    slave = _RospyLikeSlave(behaviour)
+    extra = {} if settle is None else {"settle": settle}
     try:
         _register(master, slave)
         with pytest.raises(introspect.GraphError, match="did not accept"):
-            introspect.kill_node(master.uri, "/victim")
-    finally:
-        slave.close()
-
-
-def test_kill_fails_when_the_connection_drops_but_the_node_keeps_answering(master):
-    slave = _RospyLikeSlave("drop_but_live")
-    try:
-        _register(master, slave)
-        with pytest.raises(introspect.GraphError, match="did not accept"):
-            introspect.kill_node(master.uri, "/victim", settle=0.3)
+            introspect.kill_node(master.uri, "/victim", **extra)
     finally:
         slave.close()
 
