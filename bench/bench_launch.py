@@ -137,7 +137,7 @@ def bench_cases(samples: int, rounds: int, rows: list) -> None:
     ws = str(COMPAT / "ws")
     jobs = []
     for case in cases:
-        words = ["%s:=%s" % (k, str(v).replace("${WS}", ws)) for k, v in case["args"].items()]
+        words = ["{}:={}".format(k, str(v).replace("${WS}", ws)) for k, v in case["args"].items()]
         jobs.append((os.path.join(ws, case["launch_file"]), words, _case_env(ws, case.get("env"))))
 
     # orchestra alone, as before: the compare.py contract (--no-exec), in-process vs its CLI

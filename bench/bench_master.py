@@ -207,16 +207,16 @@ def main() -> None:
     base = best[0]
     width = max(len(name) for name, _ in cases)
     print(f"{'measurement':<{width}}  {'calls/s':>9}  {'ms/call':>8}  {'x baseline':>10}")
-    for (name, _), value in zip(cases, best):
+    for (name, _), value in zip(cases, best, strict=False):
         print(f"{name:<{width}}  {value:9.0f}  {1000 / value:8.3f}  {value / base:10.2f}")
     print(f"upload_params: 1,000 params + 1 clear in one multicall: {upload_s * 1000:.1f} ms")
     print(f"{n:,} registrations (pub/sub/service mix), sequential: {register_s * 1000:.0f} ms "
           f"({n / register_s:.0f}/s)")
     if real:
-        ours_by_name = dict(zip([name for name, _ in cases], best))
+        ours_by_name = dict(zip([name for name, _ in cases], best, strict=False))
         print(f"\n{'same client, calls/s':<{width}}  {'orchestra':>9}  {'rosmaster':>9}  "
               f"{'ratio':>6}")
-        for (name, _), value in zip(theirs, best_real):
+        for (name, _), value in zip(theirs, best_real, strict=False):
             mine = ours_by_name[name]
             print(f"{name:<{width}}  {mine:9.0f}  {value:9.0f}  {mine / value:5.1f}x")
         print(f"{'upload_params, 1,000 params (ms)':<{width}}  {upload_s * 1e3:9.1f}  "

@@ -40,6 +40,7 @@ sys.path.insert(0, REPO)
 
 sys.path.insert(0, os.path.join(REPO, "bench"))
 import ros1  # noqa: E402
+
 from orchestra.supervise.output import Screen  # noqa: E402
 from orchestra.supervise.process import OutputMode, ProcessSpec, RestartPolicy, State  # noqa: E402
 from orchestra.supervise.supervisor import Supervisor  # noqa: E402
@@ -81,8 +82,8 @@ def cold_start_and_idle_cpu(n: int, idle: float) -> dict[str, float]:
                    ROS_MASTER_URI=f"http://localhost:{free_port()}/")
         env.pop("ROS_LOG_DIR", None)
         # baseline: a fresh interpreter spawning the same n processes
-        code = ("import subprocess,sys\nps=[subprocess.Popen(['sleep','1000']) for _ in range(%d)]\n"
-                "[p.kill() for p in ps]; [p.wait() for p in ps]" % n)
+        code = (f"import subprocess,sys\nps=[subprocess.Popen(['sleep','1000']) for _ in range({n})]\n"
+                "[p.kill() for p in ps]; [p.wait() for p in ps]")
         t0 = time.perf_counter()
         subprocess.run([sys.executable, "-c", code], check=True)
         baseline = time.perf_counter() - t0

@@ -92,7 +92,8 @@ PROBE = textwrap.dedent('''
 
 SINGLE = textwrap.dedent('''\
     <launch>
-      <param name="robot_description" textfile="$(find turtlebot_description)/robots/kobuki_hexagons_asus_xtion_pro.urdf"/>
+      <param name="robot_description"
+             textfile="$(find turtlebot_description)/robots/kobuki_hexagons_asus_xtion_pro.urdf"/>
       <node pkg="robot_state_publisher" type="robot_state_publisher" name="robot_state_publisher"/>
     </launch>
 ''')
@@ -153,6 +154,7 @@ SUB = textwrap.dedent('''
 def nodelet_hop(tmp: str, n: int = 2000) -> tuple[float, float]:
     """(in-process bus, TCPROS between processes): microseconds per Twist in a burst."""
     from nodelet.local import LocalBus
+
     from orchestra import node
     from orchestra.master import start_master
     from orchestra.node.msg import get_message_class

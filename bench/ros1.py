@@ -31,7 +31,7 @@ def tool(name: str) -> str | None:
     return path if os.access(path, os.X_OK) else None
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def has_modules(*modules: str) -> bool:
     """True when the ROS 1 interpreter imports every module (e.g. rospy, roslaunch)."""
     if not os.access(ROS1_PYTHON, os.X_OK):
@@ -57,7 +57,7 @@ def base_env(**extra: str) -> dict[str, str]:
     return env
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _ros_home() -> str:
     """One private ROS_HOME per bench run, removed when the run ends."""
     path = tempfile.mkdtemp(prefix="orchestra-bench-ros1-home-")

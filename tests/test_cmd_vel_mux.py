@@ -9,8 +9,7 @@ import pytest
 PACKAGES = Path(__file__).resolve().parent.parent / "packages"
 sys.path.insert(0, str(PACKAGES / "yocs_cmd_vel_mux" / "src"))
 
-from yocs_cmd_vel_mux.mux import (  # noqa: E402
-    IDLE, CmdVelMux, MuxConfigError, load_config, parse_config)
+from yocs_cmd_vel_mux.mux import IDLE, CmdVelMux, MuxConfigError, load_config, parse_config  # noqa: E402
 
 CONFIG = {"subscribers": [
     {"name": "Safety", "topic": "input/safety_controller", "timeout": 0.2, "priority": 10},

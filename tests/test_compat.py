@@ -15,7 +15,6 @@ import subprocess
 import sys
 
 import pytest
-
 from conftest import COMPAT
 
 from orchestra.errors import OrchestraError
@@ -60,7 +59,7 @@ def _set_environment(monkeypatch, ws: str, env: dict | None) -> None:
 
 
 def _resolve_in_process(ws: str, launch_file: str, args: dict | None):
-    words = ["%s:=%s" % (k, str(v).replace("${WS}", ws)) for k, v in (args or {}).items()]
+    words = ["{}:={}".format(k, str(v).replace("${WS}", ws)) for k, v in (args or {}).items()]
     interp = Interpreter(LoadOptions(args=load_mappings(words), no_exec=True))
     interp.load_file(launch_file)
     # round-trip through JSON exactly like the CLI output compare.py reads

@@ -9,10 +9,12 @@ import subprocess
 import sys
 
 import pytest
-
 from conftest import COMPAT, REPO
+
 from orchestra.errors import OrchestraError
-from orchestra.launch import convert, xml as xml_frontend, yaml as yaml_frontend
+from orchestra.launch import convert
+from orchestra.launch import xml as xml_frontend
+from orchestra.launch import yaml as yaml_frontend
 from orchestra.launch.entity import Entity
 
 WS = COMPAT / "ws"

@@ -172,8 +172,10 @@ def test_python_node_option_writes_executable_node_and_launch_file(tmp_path):
     assert "import orchestra.node as on" in source and 'get_message_class("std_msgs/String")' in source
     from lxml import etree
     node_el = etree.parse(launch).getroot().find("node")
-    assert (node_el.get("pkg"), node_el.get("type"), node_el.get("name")) == ("talker_pkg", "talker", "talker")
-    assert "catkin_install_python(PROGRAMS scripts/talker" in open(os.path.join(created.path, "CMakeLists.txt")).read()
+    assert (node_el.get("pkg"), node_el.get("type"), node_el.get("name")) == (
+        "talker_pkg", "talker", "talker")
+    cmake = open(os.path.join(created.path, "CMakeLists.txt")).read()
+    assert "catkin_install_python(PROGRAMS scripts/talker" in cmake
 
 
 def test_python_node_is_found_as_the_launch_files_executable(tmp_path, monkeypatch):

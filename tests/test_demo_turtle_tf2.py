@@ -17,7 +17,6 @@ from pathlib import Path
 from types import SimpleNamespace
 
 import pytest
-
 from test_demo_turtles import BUNDLED_ENV, run_demo, wait_until_close  # noqa: F401 - fixture
 
 REPO = Path(__file__).resolve().parent.parent
@@ -135,7 +134,7 @@ def test_auto_driver_turtle2_reaches_turtle1_within_15_seconds(run_demo, launch_
     # so count the path it was seen to travel); turtle1 really is driven
     def travelled() -> float:
         path = list(observer.samples["/turtle2/pose"])
-        return sum(math.hypot(b["x"] - a["x"], b["y"] - a["y"]) for a, b in zip(path, path[1:]))
+        return sum(math.hypot(b["x"] - a["x"], b["y"] - a["y"]) for a, b in zip(path, path[1:], strict=False))
 
     def x_range() -> float:
         xs = [s["x"] for s in list(observer.samples["/turtle1/pose"])]

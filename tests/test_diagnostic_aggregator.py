@@ -11,8 +11,17 @@ PACKAGES = Path(__file__).resolve().parent.parent / "packages"
 sys.path.insert(0, str(PACKAGES / "diagnostic_aggregator" / "src"))
 
 from diagnostic_aggregator.analyzers import (  # noqa: E402
-    ERROR, OK, STALE, WARN, Aggregator, AnalyzerConfigError, GenericAnalyzer, Status,
-    build_analyzers, remove_leading_chaff)
+    ERROR,
+    OK,
+    STALE,
+    WARN,
+    Aggregator,
+    AnalyzerConfigError,
+    GenericAnalyzer,
+    Status,
+    build_analyzers,
+    remove_leading_chaff,
+)
 
 
 def test_remove_prefix_strips_node_name_colon_and_spaces():

@@ -11,8 +11,14 @@ import os
 import pytest
 
 from orchestra.launch.plan import LaunchPlan, Node
-from orchestra.supervise.command import (BadNodeCommand, ExecutableNotFound, exec_table,
-                                         node_argv, node_cwd, node_env)
+from orchestra.supervise.command import (
+    BadNodeCommand,
+    ExecutableNotFound,
+    exec_table,
+    node_argv,
+    node_cwd,
+    node_env,
+)
 
 
 @pytest.fixture

@@ -256,8 +256,7 @@ def test_string_arrays_print_as_indented_yaml_block_lists_like_genpy():
     """Found calling roscpp's mux/list: `orchestra service call` printed
     ``topics: - /a\n- /b`` (not even YAML); rosservice (genpy) prints a block list indented
     at the field's level, nested ones too."""
-    from orchestra.node.msg import get_message_class, message_class_from_definition, \
-        to_yaml_text
+    from orchestra.node.msg import get_message_class, message_class_from_definition, to_yaml_text
 
     listing = message_class_from_definition("test_msgs/Topics", "string[] topics\n")
     assert to_yaml_text(listing(topics=["/a", "/b c", ""])) == \

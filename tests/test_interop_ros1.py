@@ -28,7 +28,6 @@ import yaml
 sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
 from harness import ROS_PYTHON, NodeProcess, ProcessGroup, wait_for  # noqa: E402
 
-
 HERE = Path(__file__).resolve().parent
 PEER = HERE / "ros1_nodes" / "peer.py"
 REPO = HERE.parent
@@ -400,7 +399,7 @@ def test_real_rostopic_echo_prints_what_orchestra_topic_echo_prints(side):
     echoes = [["/poses"], ["--noarr", "/poses"]]
     results = side.run_all(*[(*tool, "-n", "1", *words) for words in echoes
                              for tool in (("rostopic", "echo"), ("orchestra", "topic", "echo"))])
-    for real, ours in zip(results[::2], results[1::2]):
+    for real, ours in zip(results[::2], results[1::2], strict=False):
         assert real.returncode == 0 and ours.returncode == 0, real.stderr + ours.stderr
         assert without_seq(ours.stdout) == without_seq(real.stdout)
 
@@ -440,7 +439,7 @@ def test_orchestra_param_get_and_dump_print_what_real_rosparam_prints(side, mast
     commands += [("rosparam", "dump", str(tmp_path / "real.yaml"), "/d"),
                  ("orchestra", "param", "dump", str(tmp_path / "ours.yaml"), "/d")]
     results = side.run_all(*commands)
-    for real, ours in zip(results[::2], results[1::2]):
+    for real, ours in zip(results[::2], results[1::2], strict=False):
         assert real.returncode == ours.returncode == 0, real.stderr + ours.stderr
         # one deliberate difference: orchestra writes non-ASCII text as UTF-8, rosparam as
         # YAML escapes ("h\xE9llo"); both load back to the same value
@@ -512,7 +511,7 @@ def test_orchestra_node_info_prints_what_real_rosnode_info_prints(real_side):
     names = ("/talker", "/ours", "/theirs")
     results = side.run_all(*[cmd for name in names for cmd in
                              (("rosnode", "info", name), ("orchestra", "node", "info", name))])
-    for name, real, ours in zip(names, results[::2], results[1::2]):
+    for name, real, ours in zip(names, results[::2], results[1::2], strict=False):
         assert real.returncode == ours.returncode == 0, real.stderr + ours.stderr
         assert ours.stdout == real.stdout, name
     # inbound connections name the publisher as rosnode does: "/node (uri)"
@@ -550,7 +549,7 @@ def test_orchestra_tools_against_a_real_rosmaster_answer_as_the_real_tools_do(
     parity = [cmd for words in PARITY
               for cmd in ((REAL_TOOL[words[0]], *words[1:]), ("orchestra", *words))]
     results = side.run_all(*parity)
-    for words, real, ours in zip(PARITY, results[::2], results[1::2]):
+    for words, real, ours in zip(PARITY, results[::2], results[1::2], strict=False):
         assert (ours.returncode, ours.stdout) == (real.returncode, real.stdout), \
             (words, real.stderr, ours.stderr)
     # then what adds nodes to the graph (echo, pub and rosservice call are nodes; node list
@@ -564,7 +563,7 @@ def test_orchestra_tools_against_a_real_rosmaster_answer_as_the_real_tools_do(
         ("orchestra", "param", "dump", str(dump), "/robot"),
         ("orchestra", "service", "call", "/set_bool", "data: true"),
         ("orchestra", "service", "call", "/set_bool", "data: false"))
-    for words, real, ours in zip(PARITY_CALLS, results[::2], results[1::2]):
+    for words, real, ours in zip(PARITY_CALLS, results[::2], results[1::2], strict=False):
         assert (ours.returncode, ours.stdout) == (real.returncode, real.stdout), \
             (words, real.stderr, ours.stderr)
     assert (echo.returncode, echo.stdout) == (0, "1.5\n---\n"), echo.stderr

@@ -217,6 +217,7 @@ def test_example_yaml_launch_file_resolves_like_its_xml_original(compat_dir):
     """launch/turtle_tf_demo.launch.yaml, written by hand with ROS 2 spellings, launches
     exactly what turtle_tf's XML demo does."""
     from conftest import REPO
+
     from orchestra.launch.interpreter import load_launch
 
     def plan_of(path):

@@ -49,7 +49,7 @@ def test_anonymous_name_is_stable_per_id_and_sanitises_host():
     assert names.anonymous_name("foo-bar") == first
     assert names.anonymous_name("other") != first
     host = re.sub(r"[.\-:]", "_", socket.gethostname())
-    assert re.fullmatch(r"foo_bar_%s_%d_\d+" % (re.escape(host), os.getpid()), first)
+    assert re.fullmatch(rf"foo_bar_{re.escape(host)}_{os.getpid()}_\d+", first)
 
 
 def test_load_mappings_ignores_names_starting_with_a_digit_and_private_params():

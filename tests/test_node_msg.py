@@ -8,9 +8,17 @@ import pytest
 from rosbags.typesys import Stores, get_typestore
 
 from orchestra.node import msgspec
-from orchestra.node.msg import (FillError, MessageNotFound, Registry, fill_message,
-                                get_message_class, get_service_class,
-                                message_class_from_definition, to_plain, to_yaml_text)
+from orchestra.node.msg import (
+    FillError,
+    MessageNotFound,
+    Registry,
+    fill_message,
+    get_message_class,
+    get_service_class,
+    message_class_from_definition,
+    to_plain,
+    to_yaml_text,
+)
 from orchestra.node.rostime import Time
 
 STORE = get_typestore(Stores.ROS1_NOETIC)
@@ -24,7 +32,7 @@ def test_md5_algorithm_matches_rosbags_for_every_standard_message():
     for name in STANDARD:
         text, md5 = STORE.generate_msgdef(name.replace("/", "/msg/"))
         specs = msgspec.parse_full_text(text, name)
-        mine = msgspec.compute_md5(specs[name], lambda t: specs.get(t) or registry.spec(t))
+        mine = msgspec.compute_md5(specs[name], lambda t, specs=specs: specs.get(t) or registry.spec(t))
         if mine != md5:
             mismatches.append(name)
     assert mismatches == []

@@ -26,8 +26,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
 from harness import NodeProcess  # noqa: E402
 
 from orchestra.node import rostime  # noqa: E402
-from orchestra.node.exceptions import (ROSInterruptException,  # noqa: E402
-                                       ROSTimeMovedBackwardsException)
+from orchestra.node.exceptions import ROSInterruptException, ROSTimeMovedBackwardsException  # noqa: E402
 
 pytestmark = pytest.mark.timeout(60)
 
@@ -111,7 +110,7 @@ class SimWorld:
                 proc.kill()
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _rospy_missing() -> str | None:
     """Why Debian's real rospy cannot run here (None: it can); probed once."""
     if not os.access(ROS_PYTHON, os.X_OK):

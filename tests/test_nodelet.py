@@ -225,6 +225,7 @@ def test_local_bus_unregister_stops_delivery():
 def test_slow_local_subscriber_does_not_block_publisher_and_drops_oldest():
     import threading
     import time
+
     from nodelet.local import LocalBus
     bus = LocalBus()
     release, got = threading.Event(), []
@@ -269,6 +270,7 @@ def test_unload_orphans_unloads_only_nodelets_whose_loader_is_dead(workspace, tm
 
 def test_uri_alive_tells_a_listening_port_from_a_closed_one():
     import socket
+
     from nodelet.manager import uri_alive
     server = socket.socket()
     server.bind(("127.0.0.1", 0))

@@ -12,7 +12,6 @@ from pathlib import Path
 
 import pytest
 
-
 PACKAGES = Path(__file__).resolve().parent.parent / "packages"
 NODELET = str(PACKAGES / "nodelet" / "scripts" / "nodelet")
 MUX_YAML = str(PACKAGES / "yocs_cmd_vel_mux" / "param" / "example.yaml")

@@ -135,7 +135,8 @@ def test_pkg_deps_is_transitive_and_direct_with_dash_1(env, tmp_path):
 def test_pkg_deps_invalid_manifest_reports_file_and_line(env, tmp_path):
     bad = env / "broken"
     bad.mkdir()
-    (bad / "package.xml").write_text("<package format='2'>\n<name>broken</name>\n<version>1.0.0\n</package>\n")
+    (bad / "package.xml").write_text(
+        "<package format='2'>\n<name>broken</name>\n<version>1.0.0\n</package>\n")
     proc = cli("pkg", "deps", "broken", cwd=tmp_path)
     assert proc.returncode == 2
     assert f"{bad / 'package.xml'}:4" in proc.stderr and "Traceback" not in proc.stderr

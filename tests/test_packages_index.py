@@ -130,7 +130,8 @@ def test_bundled_demo_packages_are_found_with_an_empty_environment(monkeypatch, 
 
 
 def test_ros_package_path_shadows_bundled_package(monkeypatch, tmp_path):
-    names = [d for d in os.listdir(BUNDLED_PACKAGES) if os.path.isfile(os.path.join(BUNDLED_PACKAGES, d, "package.xml"))]
+    names = [d for d in os.listdir(BUNDLED_PACKAGES)
+             if os.path.isfile(os.path.join(BUNDLED_PACKAGES, d, "package.xml"))]
     bundled_name = None
     for d in names:
         text = open(os.path.join(BUNDLED_PACKAGES, d, "package.xml")).read()
@@ -250,7 +251,7 @@ def test_cache_write_is_atomic_rename_leaving_no_temporary_files(tmp_path):
     age(root)
     cache_dir = tmp_path / "cache"
     PackageIndex.build([str(root)], cache_dir=str(cache_dir))
-    assert [f for f in os.listdir(cache_dir)] == [os.path.basename(cache.cache_file(str(cache_dir), str(root)))]
+    assert os.listdir(cache_dir) == [os.path.basename(cache.cache_file(str(cache_dir), str(root)))]
 
 
 def test_cache_location_respects_ros_home_and_survives_unset_home():

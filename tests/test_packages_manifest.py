@@ -62,7 +62,8 @@ def test_format1_run_depend_means_build_export_and_exec(tmp_path):
     assert m.depends(("exec",)) == ["roscpp", "std_msgs"]
     assert m.depends(("build_export",)) == ["roscpp", "std_msgs"]
     assert m.depends(("test",)) == ["rostest"]
-    assert m.exports[0].tag == "nodelet" and dict(m.exports[0].attributes) == {"plugin": "${prefix}/plugins.xml"}
+    assert m.exports[0].tag == "nodelet"
+    assert dict(m.exports[0].attributes) == {"plugin": "${prefix}/plugins.xml"}
 
 
 def test_format3_conditions_groups_versions_and_exports(tmp_path):
@@ -103,7 +104,8 @@ def test_every_compat_manifest_agrees_with_catkin_pkg_on_name_version_and_deps(c
         theirs.evaluate_conditions(env)
         assert (ours.name, ours.version, ours.format) == (theirs.name, theirs.version, theirs.package_format)
         assert list(ours.licenses) == theirs.licenses
-        assert [(p.name, p.email) for p in ours.maintainers] == [(p.name, p.email) for p in theirs.maintainers]
+        assert ([(p.name, p.email) for p in ours.maintainers]
+                == [(p.name, p.email) for p in theirs.maintainers])
         for kind, attr in [("build", "build_depends"), ("exec", "exec_depends"),
                            ("build_export", "build_export_depends"), ("test", "test_depends"),
                            ("buildtool", "buildtool_depends"), ("doc", "doc_depends")]:
@@ -120,8 +122,10 @@ def test_every_compat_manifest_agrees_with_catkin_pkg_on_name_version_and_deps(c
     ("<package format='2'>\n<name>x</name>\n<version>1.0</version>\n</package>", 3, "MAJOR.MINOR.PATCH"),
     ("<package format='2'>\n<name>x</name>\n<version>1.0.0</version>\n<run_depend>y</run_depend>\n</package>",
      4, "unknown tag <run_depend> in a format 2"),
-    ("<package format='2'>\n<name>x</name>\n<name>y</name>\n<version>1.0.0</version>\n</package>", 3, "only once"),
-    ("<package format='2'>\n<name>x</name>\n<version>1.0.0</version>\n<depend>x</depend>\n</package>", 4, "itself"),
+    ("<package format='2'>\n<name>x</name>\n<name>y</name>\n"
+     "<version>1.0.0</version>\n</package>", 3, "only once"),
+    ("<package format='2'>\n<name>x</name>\n<version>1.0.0</version>\n"
+     "<depend>x</depend>\n</package>", 4, "itself"),
 ])
 def test_invalid_manifest_error_names_file_and_line(tmp_path, text, line, message):
     path = write(tmp_path, text)

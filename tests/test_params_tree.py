@@ -5,8 +5,7 @@ import xmlrpc.client
 
 import pytest
 
-from orchestra.params.tree import (ParamTree, ParamValueError, canonical, check_value,
-                                   namespace_of, resolve)
+from orchestra.params.tree import ParamTree, ParamValueError, canonical, check_value, namespace_of, resolve
 
 
 @pytest.fixture

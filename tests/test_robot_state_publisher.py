@@ -11,8 +11,15 @@ PACKAGES = Path(__file__).resolve().parent.parent / "packages"
 sys.path.insert(0, str(PACKAGES / "robot_state_publisher" / "src"))
 
 from robot_state_publisher.urdf import (  # noqa: E402
-    URDFError, fixed_joints, joint_positions, joint_transform, moving_joints, parse_urdf,
-    quaternion_from_rpy, rotate)
+    URDFError,
+    fixed_joints,
+    joint_positions,
+    joint_transform,
+    moving_joints,
+    parse_urdf,
+    quaternion_from_rpy,
+    rotate,
+)
 
 ARM = """<robot name="arm">
   <link name="base"/><link name="upper"/><link name="slider"/><link name="twin"/>

@@ -14,7 +14,6 @@ import subprocess
 import sys
 
 import pytest
-
 from conftest import COMPAT
 
 ROSLAUNCH = "/usr/bin/roslaunch"
@@ -35,7 +34,7 @@ def _env(case: dict, ws: str, path: str) -> dict[str, str]:
 def _both(case: dict) -> tuple[subprocess.CompletedProcess, subprocess.CompletedProcess]:
     ws = str(COMPAT / "ws")
     launch_file = os.path.join(ws, case["launch_file"])
-    args = ["%s:=%s" % (k, str(v).replace("${WS}", ws)) for k, v in (case.get("args") or {}).items()]
+    args = ["{}:={}".format(k, str(v).replace("${WS}", ws)) for k, v in (case.get("args") or {}).items()]
     real = subprocess.run([ROSLAUNCH, "--dump-params", launch_file, *args],
                           env=_env(case, ws, "/usr/bin:/bin"), capture_output=True, text=True,
                           timeout=120)
@@ -51,7 +50,7 @@ def test_dump_params_text_is_identical_to_real_roslaunch_on_every_compat_case():
     with concurrent.futures.ThreadPoolExecutor(max(2, os.cpu_count() or 2)) as pool:
         results = list(pool.map(_both, cases))
     compared, differences = 0, []
-    for case, (real, ours) in zip(cases, results):
+    for case, (real, ours) in zip(cases, results, strict=False):
         # roslaunch --dump-params exits 0 even when it cannot load the file (it only prints
         # "Unable to load file" on stderr): no stdout means it did not load
         if real.returncode != 0 or not real.stdout or ours.returncode != 0:

@@ -12,8 +12,15 @@ REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO / "packages" / "rosout" / "src"))
 
 from rosout_core.aggregator import Aggregator  # noqa: E402
-from rosout_core.logfile import (RosoutLog, format_line, format_stamp, level_name,  # noqa: E402
-                                 log_directory, plan_rotation, startup_banner)
+from rosout_core.logfile import (  # noqa: E402
+    RosoutLog,
+    format_line,
+    format_stamp,
+    level_name,
+    log_directory,
+    plan_rotation,
+    startup_banner,
+)
 
 from orchestra.launch.plan import Node  # noqa: E402
 from orchestra.supervise.rosout import ROSOUT, core_nodes, resolve_core_executables  # noqa: E402

@@ -17,8 +17,7 @@ import psutil
 import pytest
 
 from orchestra.supervise.output import Screen
-from orchestra.supervise.process import (OutputMode, ProcessSpec, RestartPolicy, State,
-                                         restart_delay)
+from orchestra.supervise.process import OutputMode, ProcessSpec, RestartPolicy, State, restart_delay
 from orchestra.supervise.supervisor import Supervisor
 
 pytestmark = pytest.mark.timeout(60)
@@ -125,7 +124,7 @@ def test_respawn_honours_respawn_delay(tmp_path):
     run(sup, until=lambda: sup.procs[0].restarts >= 2 and third_start_written())
     starts = [float(x) for x in marks.read_text().split()]
     assert len(starts) >= 3
-    assert all(b - a >= 0.35 for a, b in zip(starts, starts[1:]))
+    assert all(b - a >= 0.35 for a, b in zip(starts, starts[1:], strict=False))
 
 
 def test_crash_loop_backs_off_to_failed_without_touching_other_nodes(tmp_path):
@@ -312,7 +311,7 @@ def test_log_files_complete_after_a_crash(tmp_path):
     run(sup)
     assert sup.procs[0].exit_code == -9
     lines = (logs / "crash-1-stdout.log").read_text().splitlines()
-    assert lines == ["line %d" % i for i in range(5000)]
+    assert lines == [f"line {i}" for i in range(5000)]
     assert (logs / "crash-1-stderr.log").read_text() == "fatal: giving up\n"
     # output="log": stdout only in the file, stderr on the console too (roslaunch rule)
     assert b"line 1" not in screen.out.getvalue()

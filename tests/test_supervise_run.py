@@ -17,7 +17,7 @@ from orchestra.supervise.cli import run_plan
 from orchestra.supervise.command import node_argv
 from orchestra.supervise.output import Screen
 from orchestra.supervise.process import OutputMode, ProcessSpec, State
-from orchestra.supervise.status import StatusServer, ProcessStats, query, snapshot
+from orchestra.supervise.status import ProcessStats, StatusServer, query, snapshot
 from orchestra.supervise.supervisor import Supervisor
 
 pytestmark = pytest.mark.timeout(60)
@@ -278,7 +278,7 @@ def test_status_socket_reports_every_node(tmp_path):
     doc, table = answers
     assert doc["run_id"] == "r"
     assert [n["name"] for n in doc["nodes"]] == ["/n0", "/n1", "/n2"]
-    assert all(n["pid"] == p.pid for n, p in zip(doc["nodes"], sup.procs))
+    assert all(n["pid"] == p.pid for n, p in zip(doc["nodes"], sup.procs, strict=False))
     assert all(isinstance(n["rss"], int) and n["rss"] > 0 for n in doc["nodes"])
     lines = table.splitlines()
     assert lines[1].split()[:2] == ["NODE", "STATE"]

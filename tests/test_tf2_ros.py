@@ -30,10 +30,11 @@ def yaw(t):
 
 
 def close(a, b, tol=1e-9):
-    return all(abs(p - q) <= tol for p, q in zip(a, b))
+    return all(abs(p - q) <= tol for p, q in zip(a, b, strict=False))
 
 
-def turtles(buffer, stamp=Time(5)):
+def turtles(buffer, stamp=None):
+    stamp = Time(5) if stamp is None else stamp
     buffer.set_transform(stamped("world", "turtle1", stamp, 5.0, 5.0, 0.0))
     buffer.set_transform(stamped("world", "turtle2", stamp, 2.0, 5.0, math.pi / 2))
 

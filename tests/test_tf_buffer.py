@@ -6,8 +6,12 @@ import math
 import pytest
 
 from orchestra.tf import transformations as tfm
-from orchestra.tf.buffer import (ConnectivityException, ExtrapolationException,
-                                 LookupException, TransformBuffer)
+from orchestra.tf.buffer import (
+    ConnectivityException,
+    ExtrapolationException,
+    LookupException,
+    TransformBuffer,
+)
 from orchestra.tf.convert import fill_transform_msg, to_sec, transform_from_msg
 
 
@@ -16,7 +20,7 @@ def pose2d(x, y, yaw):
 
 
 def close(a, b, tol=1e-9):
-    return all(abs(x - y) <= tol for x, y in zip(a, b))
+    return all(abs(x - y) <= tol for x, y in zip(a, b, strict=False))
 
 
 def turtles(buf, t=1.0):

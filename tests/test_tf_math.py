@@ -9,7 +9,7 @@ from orchestra.tf import transformations as tfm
 
 
 def close(a, b, tol=1e-9):
-    return all(abs(x - y) <= tol for x, y in zip(a, b))
+    return all(abs(x - y) <= tol for x, y in zip(a, b, strict=False))
 
 
 def test_quaternion_from_euler_yaw_only_is_rotation_about_z():

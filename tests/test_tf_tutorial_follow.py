@@ -13,10 +13,11 @@ sys.path.insert(0, str(PKGS / "turtlesim" / "src"))
 sys.path.insert(0, str(PKGS / "learning_tf" / "src"))
 
 from learning_tf_core.follow import follow_command, pose_to_transform  # noqa: E402
-from orchestra.tf.buffer import TransformBuffer  # noqa: E402
-from orchestra.tf.transformations import yaw_from_quaternion  # noqa: E402
 from turtlesim_core import world as W  # noqa: E402
 from turtlesim_core.driving import Circuit  # noqa: E402
+
+from orchestra.tf.buffer import TransformBuffer  # noqa: E402
+from orchestra.tf.transformations import yaw_from_quaternion  # noqa: E402
 
 
 def test_follow_command_uses_tutorial_gains():

@@ -11,9 +11,20 @@ PACKAGES = Path(__file__).resolve().parent.parent / "packages"
 sys.path.insert(0, str(PACKAGES / "kobuki_node" / "src"))
 
 from kobuki_node.base import (  # noqa: E402
-    TICK_TO_RAD, WHEEL_BASE, WHEEL_RADIUS, BatteryModel, KobukiBase, Pose2D, integrate_pose,
-    normalize_angle, odometry_step, quaternion_to_yaw, tick_delta, wheel_speeds,
-    yaw_to_quaternion)
+    TICK_TO_RAD,
+    WHEEL_BASE,
+    WHEEL_RADIUS,
+    BatteryModel,
+    KobukiBase,
+    Pose2D,
+    integrate_pose,
+    normalize_angle,
+    odometry_step,
+    quaternion_to_yaw,
+    tick_delta,
+    wheel_speeds,
+    yaw_to_quaternion,
+)
 
 
 def test_straight_line_integration_moves_along_heading():

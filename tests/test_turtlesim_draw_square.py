@@ -9,7 +9,6 @@ import time
 from pathlib import Path
 
 import pytest
-
 from test_turtlesim_world import read_png
 
 # orchestra's bundled packages, whatever ROS workspace the developer's shell points at
@@ -46,7 +45,7 @@ def test_draw_square_draws_the_first_two_sides_from_the_centre(master, tmp_path)
             if png.exists():
                 width, _, pixels = read_png(png.read_bytes())
 
-                def on_pen(x: float, y: float) -> bool:
+                def on_pen(x: float, y: float, pixels: bytes = pixels, width: int = width) -> bool:
                     """Pen colour within a pixel of the metre point (x, y)."""
                     cx, cy = int(x * 45), int((CENTRE * 2 - y) * 45)
                     return any(tuple(pixels[((cy + dy) * width + cx + dx) * 3:

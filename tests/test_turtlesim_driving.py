@@ -58,7 +58,7 @@ def test_circuit_stands_still_while_pausing():
 def test_draw_square_path_is_a_closed_two_metre_square():
     corners = square_corners(1.0, 1.0)
     assert corners[-1] == (1.0, 1.0)
-    sides = [math.dist(a, b) for a, b in zip(((1.0, 1.0),) + corners, corners)]
+    sides = [math.dist(a, b) for a, b in zip(((1.0, 1.0),) + corners, corners, strict=False)]
     assert sides == pytest.approx([2.0] * 4)
 
 

@@ -84,7 +84,8 @@ def test_closing_the_window_signals_shutdown(monkeypatch):
 
     def frame():
         root = state["roots"][0]
-        if state["photos"] and len(state["photos"][0].data) == 1:  # the user clicks the close box after a frame
+        # the user clicks the close box after a frame
+        if state["photos"] and len(state["photos"][0].data) == 1:
             root.after(0, root.protocols["WM_DELETE_WINDOW"])
         return world.render()
 

@@ -14,7 +14,6 @@ import tempfile
 from pathlib import Path
 
 import pytest
-
 from test_turtlesim_world import read_png
 
 # orchestra's bundled packages, whatever ROS workspace the developer's shell points at

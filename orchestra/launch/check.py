@@ -24,8 +24,9 @@ import builtins
 import difflib
 import logging
 import os
+from collections.abc import Iterator
 from dataclasses import dataclass, field
-from typing import Any, Iterator
+from typing import Any
 
 import networkx
 
@@ -377,7 +378,7 @@ class Checker:
             self._check_tag(entity, parent)
             self._check_required(entity, taken)
             self._check_substitutions(entity, taken)
-            for name, value in entity.attributes.items():
+            for value in entity.attributes.values():
                 used.update(_arg_references(value))
             if entity.text and entity.tag == "rosparam":
                 used.update(_arg_references(entity.text))

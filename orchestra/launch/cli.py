@@ -75,6 +75,7 @@ def _interpret(files: list[str], args: dict[str, str], *, no_exec: bool, roscore
 
 def _dump_json(plan: Any) -> str:
     import json
+
     from orchestra.launch.interpreter import binary_to_json
     doc = plan.to_json()
     try:
@@ -165,6 +166,7 @@ def launch(words: tuple[str, ...], dump_plan: bool, dump_params: bool, nodes: bo
         click.echo(_dump_json(plan))
     elif dump_params:
         import yaml
+
         from orchestra.launch.interpreter import Binary
         yaml.SafeDumper.add_representer(Binary, yaml.SafeDumper.represent_binary)
         # roslaunch prints the YAML document (which ends in a newline) with print(), so its

@@ -33,7 +33,7 @@ class Scope:
                  "arg_names", "include_args", "pass_all_args", "args_passed",
                  "include_stack", "pending_filename")
 
-    def __init__(self, ns: str, filename: str | None, parent: "Scope | None" = None,
+    def __init__(self, ns: str, filename: str | None, parent: Scope | None = None,
                  params: list[tuple[str, Any]] | None = None,
                  env_args: list[tuple[str, str]] | None = None,
                  args: dict[str, str] | None = None,
@@ -56,7 +56,7 @@ class Scope:
         self.pending_filename: str | None = None
 
     # ------------------------------------------------------------------ children
-    def child(self, ns: str | None) -> "Scope":
+    def child(self, ns: str | None) -> Scope:
         """A scope inheriting everything; ``ns`` (relative, global or ``~``) nests it."""
         if ns:
             if ns[0] == "/":
@@ -76,7 +76,7 @@ class Scope:
                      include_args=self.include_args, pass_all_args=self.pass_all_args,
                      include_stack=self.include_stack)
 
-    def include_child(self, ns: str | None, filename: str) -> "Scope":
+    def include_child(self, ns: str | None, filename: str) -> Scope:
         """The scope an ``<include>`` tag's own ``<arg>``/``<env>`` children are read in."""
         scope = self.child(ns)
         scope.arg_names = []

@@ -165,7 +165,7 @@ def _yaml_with_comments(text: str, entity: Entity, comments: Comments) -> str:
     reread = yaml_frontend.parse_string(text, "<converted>")
     lines = text.split("\n")
     inserts: list[tuple[int, list[str]]] = []
-    for original, written in zip(_preorder(entity), _preorder(reread)):
+    for original, written in zip(_preorder(entity), _preorder(reread), strict=False):
         block = comments.get(id(original))
         if not block or written.location.line is None:
             continue
@@ -310,7 +310,7 @@ def _xml_comments(path: str, root: Entity) -> Comments:
     if len(elements) != len(entities):
         return {}  # not the tree the front end read: carry nothing rather than misplace
     comments: Comments = {}
-    for element, entity in zip(elements, entities):
+    for element, entity in zip(elements, entities, strict=False):
         block: list[str] = []
         for sibling in element.itersiblings(preceding=True):
             if isinstance(sibling.tag, str):
@@ -450,7 +450,7 @@ def convert_tree(directory: str, fmt: str) -> list[Converted]:
     for target, text in results:
         with open(target, "w", encoding="utf-8") as fh:
             fh.write(text)
-    return [Converted(src, target) for src, (target, _) in zip(sources, results)]
+    return [Converted(src, target) for src, (target, _) in zip(sources, results, strict=False)]
 
 
 def _rewrite_includes(entity: Entity, source: str, converted: set[str], fmt: str) -> None:

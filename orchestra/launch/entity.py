@@ -21,7 +21,7 @@ class Entity:
 
     tag: str
     attributes: dict[str, str] = field(default_factory=dict)
-    children: list["Entity"] = field(default_factory=list)
+    children: list[Entity] = field(default_factory=list)
     text: str | None = None
     location: Location = field(default_factory=lambda: Location("<unknown>"))
 

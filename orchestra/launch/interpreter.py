@@ -16,8 +16,9 @@ import logging
 import os
 import shlex
 import subprocess
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any
 
 from orchestra.errors import Location, OrchestraError
 from orchestra.launch.context import Scope, ScopeError
@@ -26,8 +27,7 @@ from orchestra.launch.files import read_bytes, read_text
 from orchestra.launch.plan import LaunchPlan, Machine, Node, ParamAction, Test
 from orchestra.launch.substitution import ArgNotSet, SubstitutionError, resolve
 from orchestra.launch.values import bool_attribute, convert_value, float_attribute
-from orchestra.names import (canonicalize, is_legal_name, is_private, make_global_ns,
-                             ns_join)
+from orchestra.names import canonicalize, is_legal_name, is_private, make_global_ns, ns_join
 
 log = logging.getLogger(__name__)
 
@@ -379,7 +379,7 @@ class Interpreter:
         ptype = (entity.attributes.get("type") or "auto").lower().strip()
         sources = ("value", "textfile", "binfile", "command")
         vals = self._opt(entity, scope, *sources)
-        given = [s for s, v in zip(sources, vals) if v is not None]
+        given = [s for s, v in zip(sources, vals, strict=False) if v is not None]
         if len(given) != 1:
             raise self._error(entity, "<param> must have exactly one of value/textfile/"
                               f"binfile/command (has {', '.join(given) or 'none'})")

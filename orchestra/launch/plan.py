@@ -7,9 +7,10 @@ so that ``to_json()`` is the JSON contract of ``orchestra launch --dump-plan`` (
 """
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Any, Mapping
+from typing import Any
 
 
 @dataclass(frozen=True)

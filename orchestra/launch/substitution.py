@@ -17,7 +17,8 @@ import ast
 import builtins
 import os
 import re
-from typing import Any, Callable, Mapping, Protocol
+from collections.abc import Callable, Mapping
+from typing import Any, Protocol
 
 from orchestra.errors import OrchestraError
 from orchestra.names import anonymous_name

@@ -14,8 +14,14 @@ from typing import Any
 
 from orchestra.errors import OrchestraError
 from orchestra.master.api import MasterAPI
-from orchestra.master.client import (DEFAULT_MASTER_URI, MasterUnreachable, master_is_up,
-                                     master_uri_from_env, port_from_uri, upload_params)
+from orchestra.master.client import (
+    DEFAULT_MASTER_URI,
+    MasterUnreachable,
+    master_is_up,
+    master_uri_from_env,
+    port_from_uri,
+    upload_params,
+)
 from orchestra.master.notify import Notifier
 from orchestra.master.server import ThreadedXMLRPCServer, bind_address
 from orchestra.params.tree import ParamTree
@@ -85,7 +91,7 @@ class MasterHandle:
     def running(self) -> bool:
         return not self._stopping
 
-    def __enter__(self) -> "MasterHandle":
+    def __enter__(self) -> MasterHandle:
         return self
 
     def __exit__(self, *exc: Any) -> None:

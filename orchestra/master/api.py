@@ -12,14 +12,28 @@ from __future__ import annotations
 import logging
 import os
 import threading
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any
 
 from orchestra.master.notify import MASTER_CALLER_ID, Notifier
-from orchestra.master.registrations import (ANYTYPE, PARAM_SUBSCRIBER, PUBLISHER, SERVICE,
-                                            SUBSCRIBER, Registrations)
-from orchestra.params.tree import (SEP, ParamTree, ParamUpdate, ParamValueError, check_value,
-                                   resolve, subscription_key)
+from orchestra.master.registrations import (
+    ANYTYPE,
+    PARAM_SUBSCRIBER,
+    PUBLISHER,
+    SERVICE,
+    SUBSCRIBER,
+    Registrations,
+)
+from orchestra.params.tree import (
+    SEP,
+    ParamTree,
+    ParamUpdate,
+    ParamValueError,
+    check_value,
+    resolve,
+    subscription_key,
+)
 
 log = logging.getLogger(__name__)
 
@@ -144,7 +158,7 @@ class MasterAPI:
             return -1, "caller_id must be a string", spec.error_value
         args: list[Any] = [caller_id]
         try:
-            for validator, value in zip(spec.validators, params[1:]):
+            for validator, value in zip(spec.validators, params[1:], strict=False):
                 args.append(validator(value, caller_id) if validator else value)
             return fn(*args)
         except Invalid as exc:

@@ -30,8 +30,14 @@ class MasterAlreadyRunning(OrchestraError):
               help="Do not start the /rosout node (log aggregation on /rosout_agg).")
 def core(port: int | None, host: str | None, no_rosout: bool) -> None:
     """Run a ROS master, parameter server and the rosout node until interrupted."""
-    from orchestra.master import (bind_address, core_params, master_is_up,
-                                  master_uri_from_env, port_from_uri, start_master)
+    from orchestra.master import (
+        bind_address,
+        core_params,
+        master_is_up,
+        master_uri_from_env,
+        port_from_uri,
+        start_master,
+    )
 
     if port is None:
         port = port_from_uri(master_uri_from_env())

@@ -6,11 +6,11 @@ embedded one, or ROS's own rosmaster.
 from __future__ import annotations
 
 import os
-import socket
 import urllib.parse
 import xmlrpc.client
+from collections.abc import Mapping, Sequence
 from http.client import HTTPException
-from typing import Any, Mapping, Sequence
+from typing import Any
 
 from orchestra.errors import OrchestraError
 from orchestra.master.notify import TimeoutTransport
@@ -55,7 +55,7 @@ def master_is_up(uri: str, timeout: float = 1.0) -> bool:
     """True when something at ``uri`` answers ``getPid`` like a ROS master."""
     try:
         code, _, _ = proxy(uri, timeout).getPid("/orchestra")
-    except (*TRANSPORT_ERRORS, xmlrpc.client.Fault, ValueError, TypeError, socket.timeout):
+    except (TimeoutError, *TRANSPORT_ERRORS, xmlrpc.client.Fault, ValueError, TypeError):
         return False
     return code == 1
 
@@ -84,6 +84,6 @@ def upload_params(master_uri: str, params: Mapping[str, Any], clear_params: Sequ
                              f"{exc.faultString}") from None
     except TRANSPORT_ERRORS as exc:
         raise MasterUnreachable(f"cannot reach the master at {master_uri}: {exc}") from None
-    for name, (code, message, _) in zip(names, results[len(clear_params):]):
+    for name, (code, message, _) in zip(names, results[len(clear_params):], strict=False):
         if code != 1:
             raise OrchestraError(f"master refused parameter '{name}': {message}")

@@ -5,19 +5,48 @@ Names and behaviour follow rospy (``init_node``, ``Publisher``, ``Subscriber``, 
 protocol is ROS 1's TCPROS, so these nodes talk to rospy/roscpp nodes and to a real
 rosmaster as well as to orchestra's. Message classes come from ``orchestra.node.msg``.
 """
-from orchestra.node.exceptions import (ROSException, ROSInitException, ROSInterruptException,
-                                       ROSTimeMovedBackwardsException, SerializationError,
-                                       ServiceException, TransportException)
+from orchestra.node.exceptions import (
+                                       ROSException,
+                                       ROSInitException,
+                                       ROSInterruptException,
+                                       ROSTimeMovedBackwardsException,
+                                       SerializationError,
+                                       ServiceException,
+                                       TransportException,
+)
 from orchestra.node.msg import AnyMsg, get_message_class, get_service_class
 from orchestra.node.rostime import Duration, Rate, Time, get_rostime, get_time, sleep
-from orchestra.node.runtime import (delete_param, get_caller_id, get_master_uri, get_name,
-                                    get_namespace, get_node_uri, get_param, get_param_cached,
-                                    get_param_names, get_published_topics, has_param,
-                                    init_node, is_shutdown, logdebug, logerr, logfatal,
-                                    loginfo, loginfo_throttle, logwarn, logwarn_throttle,
-                                    myargv, on_shutdown, remap_name, resolve_name,
-                                    search_param, set_param, signal_shutdown, spin,
-                                    wait_for_message)
+from orchestra.node.runtime import (
+                                       delete_param,
+                                       get_caller_id,
+                                       get_master_uri,
+                                       get_name,
+                                       get_namespace,
+                                       get_node_uri,
+                                       get_param,
+                                       get_param_cached,
+                                       get_param_names,
+                                       get_published_topics,
+                                       has_param,
+                                       init_node,
+                                       is_shutdown,
+                                       logdebug,
+                                       logerr,
+                                       logfatal,
+                                       loginfo,
+                                       loginfo_throttle,
+                                       logwarn,
+                                       logwarn_throttle,
+                                       myargv,
+                                       on_shutdown,
+                                       remap_name,
+                                       resolve_name,
+                                       search_param,
+                                       set_param,
+                                       signal_shutdown,
+                                       spin,
+                                       wait_for_message,
+)
 from orchestra.node.services import Service, ServiceProxy, wait_for_service
 from orchestra.node.timer import Timer, TimerEvent
 from orchestra.node.topics import Publisher, Subscriber

@@ -156,7 +156,7 @@ def node_info(name: str) -> None:
             # rospy and roscpp describe the socket in a 7th field; rosnode shows it too
             socket_info = CONNECTION_TEXT.match(row[6]) if len(row) > 6 else None
             if socket_info:
-                way += " (%s - %s) [%s]" % socket_info.groups()
+                way += " ({} - {}) [{}]".format(*socket_info.groups())
             click.echo(f"    * direction: {way}")
             click.echo(f"    * transport: {transport}")
     click.echo("")  # rosnode prints the whole block, then a blank line
@@ -395,8 +395,7 @@ class _Decoder:
         self._classes: dict[tuple[str, str], type] = {}
 
     def __call__(self, raw):
-        from orchestra.node.msg import MessageNotFound, get_message_class, \
-            message_class_from_definition
+        from orchestra.node.msg import MessageNotFound, get_message_class, message_class_from_definition
         header = raw._connection_header
         key = (header.get("type", ""), header.get("md5sum", ""))
         cls = self._classes.get(key)
@@ -461,7 +460,7 @@ def hide_arrays(msg) -> None:
     """``--noarr``: each array field of ``msg`` (top level only) becomes rostopic's
     ``<array type: T, length: N>`` text; T is the field type with its trailing brackets
     stripped as rostopic strips them (``float64[3]`` gives ``float64[3``)."""
-    for field_name, slot_type in zip(msg._fields, msg._slot_types):
+    for field_name, slot_type in zip(msg._fields, msg._slot_types, strict=False):
         if "[" in slot_type:
             length = len(getattr(msg, field_name))
             setattr(msg, field_name,
@@ -603,7 +602,7 @@ def topic_hz(name: str, window: int | None, reports: int | None) -> None:
 
 def hz_report(stamps: list[float]) -> str:
     """rostopic hz's block: average rate, then min/max/std dev of the periods and window."""
-    periods = [b - a for a, b in zip(stamps, stamps[1:])]
+    periods = [b - a for a, b in zip(stamps, stamps[1:], strict=False)]
     mean = sum(periods) / len(periods)
     std = math.sqrt(sum((p - mean) ** 2 for p in periods) / len(periods))
     rate = 1.0 / mean if mean > 0 else 0.0

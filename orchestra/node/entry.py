@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import os
 import sys
-from typing import Callable
+from collections.abc import Callable
 
 from orchestra.node.exceptions import ROSException, ROSInterruptException
 

@@ -8,7 +8,6 @@ extra connect costs tens of microseconds.
 from __future__ import annotations
 
 import http.client
-import socket
 import xmlrpc.client
 from typing import Any
 
@@ -44,8 +43,7 @@ def raw_call(uri: str, method: str, *args: Any, timeout: float = DEFAULT_TIMEOUT
     """``[code, msg, value]`` from ``method`` at ``uri``; unreachable -> MasterError."""
     try:
         result = getattr(proxy(uri, timeout), method)(*args)
-    except (OSError, http.client.HTTPException, xmlrpc.client.ProtocolError,
-            socket.timeout) as exc:
+    except (TimeoutError, OSError, http.client.HTTPException, xmlrpc.client.ProtocolError) as exc:
         raise MasterError(f"cannot reach {uri} ({method}): {exc}") from exc
     except xmlrpc.client.Fault as exc:
         raise MasterError(f"{uri} {method} failed: {exc.faultString}") from exc

@@ -48,7 +48,7 @@ class Message:
             if len(args) != len(self._fields):
                 raise TypeError(f"{self._type} takes {len(self._fields)} field values "
                                 f"({', '.join(self._fields)}), got {len(args)}")
-            for name, value in zip(self._fields, args):
+            for name, value in zip(self._fields, args, strict=False):
                 setattr(self, name, value)
             return
         for name, value in kwargs.items():
@@ -74,7 +74,7 @@ class Message:
         return out
 
     @classmethod
-    def deserialize_bytes(cls, data) -> "Message":
+    def deserialize_bytes(cls, data) -> Message:
         """A new message read from its ROS 1 serialization."""
         if not isinstance(data, bytes):
             data = bytes(data)
@@ -90,7 +90,7 @@ class Message:
         """rospy's spelling: write the serialization into a file-like ``buff``."""
         buff.write(self.serialize_bytes())
 
-    def deserialize(self, data) -> "Message":
+    def deserialize(self, data) -> Message:
         """rospy's spelling: fill this instance from ``data`` and return it."""
         other = self.deserialize_bytes(data)
         for name in self._fields:
@@ -121,7 +121,7 @@ class Message:
         return [getattr(self, n) for n in self._fields]
 
     def __setstate__(self, state) -> None:
-        for name, value in zip(self._fields, state):
+        for name, value in zip(self._fields, state, strict=False):
             setattr(self, name, value)
 
 
@@ -140,7 +140,7 @@ class AnyMsg(Message):
         return self._buff
 
     @classmethod
-    def deserialize_bytes(cls, data) -> "AnyMsg":
+    def deserialize_bytes(cls, data) -> AnyMsg:
         return cls(bytes(data))
 
 
@@ -172,7 +172,7 @@ class Registry:
     """Type name -> spec -> class, loaded on first use from the sources listed above."""
 
     def __init__(self, preloaded: dict[str, MsgSpec] | None = None,
-                 parent: "Registry | None" = None):
+                 parent: Registry | None = None):
         self._lock = threading.RLock()
         self._specs: dict[str, MsgSpec] = dict(preloaded or {})
         self._md5: dict[str, str] = {}
@@ -387,7 +387,7 @@ def _strify(value: Any, indent: str, slot_type: str = "") -> str:
     if isinstance(value, Message):
         child = "  " + indent
         lines = [f"{indent}{name}: {_strify(getattr(value, name), child, t)}"
-                 for name, t in zip(value._fields, value._slot_types)]
+                 for name, t in zip(value._fields, value._slot_types, strict=False)]
         text = "\n".join(lines)
         return "\n" + text if indent else text
     return str(value)
@@ -491,7 +491,7 @@ def fill_message(msg: Message, value: Any, path: str = "") -> Message:
         if len(value) != len(fields):
             raise FillError(f"{msg._type} takes {len(fields)} values "
                             f"({', '.join(f.name for f in fields)}), got {len(value)}")
-        for f, val in zip(fields, value):
+        for f, val in zip(fields, value, strict=False):
             sub = f"{path}.{f.name}" if path else f.name
             setattr(msg, f.name, _fill_field(getattr(msg, f.name), val, f.base, f.array, sub))
         return msg

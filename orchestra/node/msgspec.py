@@ -11,8 +11,8 @@ from __future__ import annotations
 import hashlib
 import keyword
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 from orchestra.node.exceptions import ROSException
 

@@ -13,9 +13,8 @@ import time
 from dataclasses import dataclass, field
 
 from orchestra.names import canonicalize as canonical
-from orchestra.names import is_legal_name, make_global_ns
+from orchestra.names import is_legal_name, make_global_ns, resolve_name
 from orchestra.names import namespace as namespace_of
-from orchestra.names import resolve_name
 
 __all__ = ["NodeArgs", "anonymous_name", "canonical", "is_legal_name", "is_remap_arg",
            "make_global_ns", "namespace_of", "parse_args", "resolve", "resolve_remaps"]

@@ -78,10 +78,10 @@ class Duration(_TimeBase):
 
     __slots__ = ()
 
-    def __neg__(self) -> "Duration":
+    def __neg__(self) -> Duration:
         return Duration(0, -self.to_nsec())
 
-    def __abs__(self) -> "Duration":
+    def __abs__(self) -> Duration:
         return Duration(0, abs(self.to_nsec()))
 
     def __add__(self, other):
@@ -98,7 +98,7 @@ class Duration(_TimeBase):
             return Duration(0, self.to_nsec() - other.to_nsec())
         return NotImplemented
 
-    def __mul__(self, factor: float) -> "Duration":
+    def __mul__(self, factor: float) -> Duration:
         return Duration(0, int(round(self.to_nsec() * factor)))
 
     __rmul__ = __mul__
@@ -120,7 +120,7 @@ class Time(_TimeBase):
             raise ValueError("Time cannot be negative")
 
     @classmethod
-    def now(cls) -> "Time":
+    def now(cls) -> Time:
         """The current ROS time: the last ``/clock`` message under simulated time (0 until
         the first one arrives), otherwise wall time."""
         return cls(0, _now_ns())

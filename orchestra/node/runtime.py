@@ -19,14 +19,19 @@ import socket
 import sys
 import threading
 import time
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 from urllib.parse import urlparse
 
 import yaml
 
 from orchestra.node import names, rostime, tcpros
-from orchestra.node.exceptions import (ROSException, ROSInitException, ROSInterruptException,
-                                       TransportException)
+from orchestra.node.exceptions import (
+    ROSException,
+    ROSInitException,
+    ROSInterruptException,
+    TransportException,
+)
 from orchestra.node.masterapi import Master, MasterError
 from orchestra.node.topics import TopicManager
 
@@ -52,7 +57,7 @@ def _advertise_host(special: dict[str, str], master_uri: str) -> str:
 class TcprosServer:
     """Accepts TCPROS connections and hands each to the topic or service it asks for."""
 
-    def __init__(self, runtime: "NodeRuntime", bind_host: str, advertise_host: str,
+    def __init__(self, runtime: NodeRuntime, bind_host: str, advertise_host: str,
                  port: int = 0):
         self.rt = runtime
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)

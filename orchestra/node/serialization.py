@@ -89,7 +89,7 @@ class _Gen:
         self.de.append(f"    _v = {s}.unpack_from(buf, p)")
         self.de.append(f"    p += {st.size}")
         i = 0
-        for fmt_part, exprs_part, assigns in self.pending:
+        for _fmt_part, exprs_part, assigns in self.pending:
             n = len(exprs_part)
             vals = [f"_v[{i + k}]" for k in range(n)]
             for line in assigns:

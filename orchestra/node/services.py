@@ -12,11 +12,16 @@ import logging
 import socket
 import threading
 import time
-from typing import TYPE_CHECKING, Any, Callable
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
 
 from orchestra.node import tcpros
-from orchestra.node.exceptions import (ROSException, ROSInterruptException, ServiceException,
-                                       TransportException)
+from orchestra.node.exceptions import (
+    ROSException,
+    ROSInterruptException,
+    ServiceException,
+    TransportException,
+)
 from orchestra.node.masterapi import MasterError
 from orchestra.node.msg import Message, ServiceDefinition
 
@@ -47,7 +52,7 @@ def _as_response(value: Any, response_class: type[Message]) -> Message:
 class ServiceServer:
     """One service this node offers (shared by the ``Service`` handle that created it)."""
 
-    def __init__(self, runtime: "NodeRuntime", name: str, srv_class: type[ServiceDefinition],
+    def __init__(self, runtime: NodeRuntime, name: str, srv_class: type[ServiceDefinition],
                  handler: Callable):
         self.runtime = runtime
         self.name = name
@@ -114,7 +119,7 @@ class ServiceServer:
         except Exception as exc:  # the handler's error goes back to the caller
             log.error("service %s: error processing request from %s: %s", self.name, caller, exc)
             tcpros.send_service_response(sock, False,
-                                         f"error processing request: {exc}".encode("utf-8"))
+                                         f"error processing request: {exc}".encode())
             return
         self.calls += 1
         self.bytes_in += len(data) + 4

@@ -34,7 +34,7 @@ class _Server(socketserver.ThreadingMixIn, SimpleXMLRPCServer):
 class SlaveAPI:
     """The methods exposed over XML-RPC; each delegates to the node runtime."""
 
-    def __init__(self, runtime: "NodeRuntime"):
+    def __init__(self, runtime: NodeRuntime):
         self._rt = runtime
 
     def getBusStats(self, caller_id: str) -> list:
@@ -75,14 +75,14 @@ class SlaveAPI:
         for proto in protocols:
             if proto and proto[0] == "TCPROS":
                 host, port = self._rt.tcpros_address
-                return [1, "ready on %s:%d" % (host, port), ["TCPROS", host, port]]
+                return [1, f"ready on {host}:{port:d}", ["TCPROS", host, port]]
         return [0, "no supported protocol implementations", []]
 
 
 class SlaveServer:
     """An XML-RPC server on an ephemeral port, serving ``SlaveAPI`` from a daemon thread."""
 
-    def __init__(self, runtime: "NodeRuntime", bind_host: str, advertise_host: str, port: int = 0):
+    def __init__(self, runtime: NodeRuntime, bind_host: str, advertise_host: str, port: int = 0):
         self._server = _Server((bind_host, port), _QuietHandler,
                                logRequests=False, allow_none=False)
         self._server.register_instance(SlaveAPI(runtime))

@@ -21,7 +21,7 @@ def encode_header(fields: dict[str, str]) -> bytes:
     """The wire form of a connection header (values are str; utf-8 on the wire)."""
     body = bytearray()
     for key, value in fields.items():
-        item = f"{key}={value}".encode("utf-8")
+        item = f"{key}={value}".encode()
         body += _U32.pack(len(item))
         body += item
     return _U32.pack(len(body)) + bytes(body)

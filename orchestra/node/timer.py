@@ -4,8 +4,8 @@ from __future__ import annotations
 import logging
 import threading
 import time as _time
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 from orchestra.node import rostime
 from orchestra.node.exceptions import ROSInterruptException, ROSTimeMovedBackwardsException

@@ -15,7 +15,8 @@ import select
 import socket
 import struct
 import threading
-from typing import TYPE_CHECKING, Any, Callable
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
 
 from orchestra.node import tcpros
 from orchestra.node.exceptions import ROSException, TransportException
@@ -44,7 +45,7 @@ class OutConnection:
 
     _ids = iter(range(1, 1 << 62))
 
-    def __init__(self, publication: "Publication", sock: socket.socket, peer: str,
+    def __init__(self, publication: Publication, sock: socket.socket, peer: str,
                  queue_size: int | None):
         self.id = next(OutConnection._ids)
         self.publication = publication
@@ -115,7 +116,7 @@ class OutConnection:
 class Publication:
     """Everything this node knows about one topic it publishes."""
 
-    def __init__(self, runtime: "NodeRuntime", topic: str, msg_class: type[Message],
+    def __init__(self, runtime: NodeRuntime, topic: str, msg_class: type[Message],
                  latch: bool, queue_size: int | None):
         self.runtime = runtime
         self.topic = topic
@@ -233,7 +234,7 @@ class Publisher:
 class InConnection:
     """Our link to one publisher: connect, read, dispatch, reconnect with backoff."""
 
-    def __init__(self, subscription: "Subscription", publisher_uri: str):
+    def __init__(self, subscription: Subscription, publisher_uri: str):
         self.subscription = subscription
         self.uri = publisher_uri
         self.closed = threading.Event()
@@ -368,7 +369,7 @@ class _Refused(Exception):
 class Subscription:
     """Everything this node knows about one topic it subscribes to."""
 
-    def __init__(self, runtime: "NodeRuntime", topic: str, msg_class: type[Message],
+    def __init__(self, runtime: NodeRuntime, topic: str, msg_class: type[Message],
                  queue_size: int | None = None):
         self.runtime = runtime
         self.topic = topic
@@ -412,7 +413,7 @@ class Subscription:
             return len(self.callbacks)
 
     def deliver_raw(self, data: bytes, header: dict[str, str], origin: str,
-                    latched_on: "InConnection | None" = None) -> None:
+                    latched_on: InConnection | None = None) -> None:
         """Decode once per message class the callbacks asked for, then call them in order.
         ``latched_on``: the connection of a latched publisher, which keeps the message for
         callbacks added later."""
@@ -515,7 +516,7 @@ class Subscriber:
 class TopicManager:
     """This node's publications and subscriptions, and their master registrations."""
 
-    def __init__(self, runtime: "NodeRuntime"):
+    def __init__(self, runtime: NodeRuntime):
         self.rt = runtime
         self.lock = threading.RLock()
         self.publications: dict[str, Publication] = {}

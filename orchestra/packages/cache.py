@@ -16,7 +16,7 @@ import hashlib
 import json
 import logging
 import os
-from typing import Mapping
+from collections.abc import Mapping
 
 from orchestra.packages.crawl import Record
 

@@ -30,7 +30,8 @@ TEMPLATES = os.path.join(os.path.dirname(os.path.abspath(__file__)), "templates"
 NAME_OK = re.compile(r"^[a-zA-Z0-9][a-zA-Z0-9_-]*$")
 NAME_CONVENTION = re.compile(r"^[a-z][a-z0-9_-]*$")
 VERSION_OK = re.compile(r"^[0-9]+\.[0-9]+\.[0-9]+$")
-EMAIL_OK = re.compile(r"^[-a-zA-Z0-9_%+]+(\.[-a-zA-Z0-9_%+]+)*@[-a-zA-Z0-9%]+(\.[-a-zA-Z0-9%]+)*\.[a-zA-Z]{2,}$")
+EMAIL_OK = re.compile(r"^[-a-zA-Z0-9_%+]+(\.[-a-zA-Z0-9_%+]+)*"
+                      r"@[-a-zA-Z0-9%]+(\.[-a-zA-Z0-9%]+)*\.[a-zA-Z]{2,}$")
 NODE_NAME_OK = re.compile(r"^[a-zA-Z][a-zA-Z0-9_]*$")
 
 

@@ -14,8 +14,9 @@ from __future__ import annotations
 
 import os
 import sys
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Mapping
+
 
 #: orchestra's own demo packages: ``packages/`` at the repository root
 def _bundled_packages_dir() -> str:

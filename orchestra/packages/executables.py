@@ -12,12 +12,11 @@ one it happens to walk into).
 from __future__ import annotations
 
 import os
-from typing import Mapping
+from collections.abc import Mapping
 
 from orchestra.errors import OrchestraError
 from orchestra.packages.discovery import CATKIN_MARKER, catkin_prefixes, current_directory
 from orchestra.packages.index import find_package
-
 
 #: prefixes that are catkin install spaces without carrying the ``.catkin`` marker: Debian
 #: installs ROS packages straight into ``/usr`` and patches catkin's ``get_workspaces()`` to

@@ -18,8 +18,13 @@ from dataclasses import dataclass, field
 from orchestra.errors import OrchestraError
 from orchestra.packages import cache
 from orchestra.packages.crawl import crawl
-from orchestra.packages.discovery import (BUNDLED_PACKAGES, SearchRoot, current_directory,
-                                          search_path, search_roots)
+from orchestra.packages.discovery import (
+    BUNDLED_PACKAGES,
+    SearchRoot,
+    current_directory,
+    search_path,
+    search_roots,
+)
 
 log = logging.getLogger(__name__)
 
@@ -60,7 +65,7 @@ class PackageIndex:
     metapackages: dict[str, str] = field(default_factory=dict)
 
     @classmethod
-    def build(cls, roots: list[str] | list[SearchRoot], cache_dir=_USE_DEFAULT) -> "PackageIndex":
+    def build(cls, roots: list[str] | list[SearchRoot], cache_dir=_USE_DEFAULT) -> PackageIndex:
         """Crawl ``roots`` in order; ``cache_dir=None`` disables the disk cache."""
         if cache_dir is _USE_DEFAULT:
             cache_dir = cache.default_cache_dir()

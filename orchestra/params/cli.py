@@ -15,11 +15,9 @@ from typing import Any
 import click
 
 from orchestra.errors import Location, OrchestraError
-from orchestra.master.client import (TRANSPORT_ERRORS, MasterUnreachable, master_uri_from_env,
-                                     proxy)
+from orchestra.master.client import TRANSPORT_ERRORS, MasterUnreachable, master_uri_from_env, proxy
 from orchestra.params.dump import dump_yaml, format_get
-from orchestra.params.tree import (SEP, ParamValueError, canonical, check_value, ns_join,
-                                   resolve)
+from orchestra.params.tree import SEP, ParamValueError, canonical, check_value, ns_join, resolve
 
 NS_KEY = "_ns"  # a YAML document's own namespace, as rosparam reads it
 
@@ -76,7 +74,7 @@ class _Master:
         except TRANSPORT_ERRORS as exc:
             raise MasterUnreachable(f"unable to communicate with master at {self.uri}: {exc}"
                                     ) from None
-        for (name, _), (code, message, _) in zip(items, results):
+        for (name, _), (code, message, _) in zip(items, results, strict=False):
             if code != 1:
                 raise ParamCommandError(f"{name}: {message}")
 

@@ -17,8 +17,9 @@ from __future__ import annotations
 import datetime
 import threading
 import xmlrpc.client
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
-from typing import Any, Callable, Iterator
+from typing import Any
 
 from orchestra.errors import Location, OrchestraError
 from orchestra.names import canonicalize, namespace, ns_join

@@ -8,7 +8,8 @@ supervisor is imported inside the functions.
 from __future__ import annotations
 
 import json
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 import click
 
@@ -61,7 +62,8 @@ def run_options(func: Callable[..., Any]) -> Callable[..., Any]:
 
 def run_plan(plan: Any, options: dict[str, Any]) -> int:
     """Run the plan's nodes under supervision; returns orchestra's exit code."""
-    from orchestra.supervise.runner import parse_size, run_plan as _run
+    from orchestra.supervise.runner import parse_size
+    from orchestra.supervise.runner import run_plan as _run
 
     options = dict(options)
     if "log_max_size" in options:
@@ -85,8 +87,7 @@ def status(as_json: bool, socket_path: str | None, use_master: bool) -> int:
 
     By default every launch of this user on this machine answers over its local socket.
     """
-    from orchestra.supervise.status import (launches_on_master, query, running_launches,
-                                            table_lines)
+    from orchestra.supervise.status import launches_on_master, query, running_launches, table_lines
 
     if socket_path:
         try:

@@ -18,7 +18,8 @@ from __future__ import annotations
 
 import os
 import shlex
-from typing import Any, Mapping
+from collections.abc import Mapping
+from typing import Any
 
 from orchestra.errors import Location, OrchestraError
 from orchestra.launch.plan import LaunchPlan, Node

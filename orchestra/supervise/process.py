@@ -14,8 +14,8 @@ from __future__ import annotations
 import enum
 import logging
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Mapping
 
 logger = logging.getLogger(__name__)
 

@@ -33,7 +33,7 @@ import shutil
 import signal
 import subprocess
 import warnings
-from typing import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 
 import psutil
 
@@ -61,7 +61,7 @@ def child_setup(parent_pid: int) -> Callable[[], None]:
     return setup
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def setpriv_prefix() -> tuple[str, ...] | None:
     """``setpriv --pdeathsig KILL --`` when this machine's setpriv supports it, else None."""
     path = shutil.which("setpriv")

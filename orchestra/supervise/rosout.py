@@ -17,7 +17,8 @@ from __future__ import annotations
 
 import logging
 import threading
-from typing import TYPE_CHECKING, Callable, Sequence
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING
 
 from orchestra.errors import OrchestraError
 from orchestra.launch.plan import Node
@@ -55,7 +56,7 @@ def resolve_core_executables(nodes: Sequence[Node], warn: Callable[[str], None]
 
 
 def serve_core(handle, run_id: str, rosout: bool, watchdog, echo: Callable[[str], None],
-               announce: Callable[[], None] | None = None) -> "RunResult":
+               announce: Callable[[], None] | None = None) -> RunResult:
     """``orchestra core`` after its master is up: supervise the core nodes until a signal or
     the master's own ``shutdown``; the result's exit code is 1 when a core node ended FAILED.
 

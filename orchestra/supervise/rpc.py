@@ -14,7 +14,8 @@ import logging
 import os
 import re
 import socket
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 from xmlrpc.server import SimpleXMLRPCServer
 
 from orchestra.supervise.loop import EventLoop

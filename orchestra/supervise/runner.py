@@ -17,8 +17,9 @@ import time
 import urllib.parse
 import uuid
 import xmlrpc.client
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
-from typing import Any, Mapping
+from typing import Any
 
 import click
 
@@ -57,7 +58,7 @@ class RunOptions:
     no_rosout: bool = False
 
     @classmethod
-    def from_kwargs(cls, options: Mapping[str, Any]) -> "RunOptions":
+    def from_kwargs(cls, options: Mapping[str, Any]) -> RunOptions:
         known = {f for f in cls.__dataclass_fields__}
         values = {k: v for k, v in options.items() if k in known and v is not None}
         if "node_timeouts" in values and not isinstance(values["node_timeouts"], Mapping):

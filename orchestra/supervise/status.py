@@ -11,7 +11,8 @@ import json
 import os
 import socket
 import stat
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 import psutil
 

@@ -19,18 +19,33 @@ import signal
 import subprocess
 import threading
 import time
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Callable, Sequence
 
 import psutil
 
 from orchestra.supervise.loop import EventLoop, Timer
 from orchestra.supervise.output import NodeOutput, Screen
-from orchestra.supervise.process import (TERMINAL, ManagedProcess, ProcessSpec, RestartPolicy,
-                                         State, describe_exit, restart_delay)
-from orchestra.supervise.reaper import (MARK_VARIABLE, Watchdog, check_executable, child_setup,
-                                        descendants, marked_pids, new_mark, setpriv_prefix,
-                                        signal_group)
+from orchestra.supervise.process import (
+    TERMINAL,
+    ManagedProcess,
+    ProcessSpec,
+    RestartPolicy,
+    State,
+    describe_exit,
+    restart_delay,
+)
+from orchestra.supervise.reaper import (
+    MARK_VARIABLE,
+    Watchdog,
+    check_executable,
+    child_setup,
+    descendants,
+    marked_pids,
+    new_mark,
+    setpriv_prefix,
+    signal_group,
+)
 
 logger = logging.getLogger(__name__)
 

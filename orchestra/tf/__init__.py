@@ -10,14 +10,25 @@ tf2_ros's API (a ``Buffer`` whose lookups return TransformStamped messages, fed 
 The math (``transformations``) and the tree (``buffer``) are pure; the broadcaster and
 listener import the node runtime only when constructed, so importing this package is cheap.
 """
-from orchestra.tf.broadcaster import (StaticTransformBroadcaster, TransformBroadcaster,
-                                      make_transform)
-from orchestra.tf.buffer import (ConnectivityException, ExtrapolationException,
-                                 LookupException, TransformBuffer, TransformException)
+from orchestra.tf.broadcaster import StaticTransformBroadcaster, TransformBroadcaster, make_transform
+from orchestra.tf.buffer import (
+                                      ConnectivityException,
+                                      ExtrapolationException,
+                                      LookupException,
+                                      TransformBuffer,
+                                      TransformException,
+)
 from orchestra.tf.listener import TransformListener
-from orchestra.tf.transformations import (compose, euler_from_quaternion, inverse,
-                                          quaternion_from_euler, quaternion_multiply,
-                                          rotate_vector, transform_point, yaw_from_quaternion)
+from orchestra.tf.transformations import (
+                                      compose,
+                                      euler_from_quaternion,
+                                      inverse,
+                                      quaternion_from_euler,
+                                      quaternion_multiply,
+                                      rotate_vector,
+                                      transform_point,
+                                      yaw_from_quaternion,
+)
 
 __all__ = [
     "TransformBroadcaster", "StaticTransformBroadcaster", "TransformListener",

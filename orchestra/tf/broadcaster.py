@@ -7,7 +7,8 @@ users copy from use both.
 from __future__ import annotations
 
 import threading
-from typing import Any, Iterable, Sequence
+from collections.abc import Iterable, Sequence
+from typing import Any
 
 from orchestra.tf.convert import fill_transform_msg
 

@@ -160,7 +160,7 @@ class TransformBuffer:
 
     def _latest_common_time(self, path: list[str]) -> float:
         latest = None
-        for a, b in zip(path, path[1:]):
+        for a, b in zip(path, path[1:], strict=False):
             edge = self._edges[a] if a in self._edges and self._edges[a].parent == b \
                 else self._edges[b]
             if edge.static:
@@ -181,7 +181,7 @@ class TransformBuffer:
             if not stamp:
                 stamp = self._latest_common_time(path)
             result = tfm.IDENTITY
-            for a, b in zip(path, path[1:]):
+            for a, b in zip(path, path[1:], strict=False):
                 up = self._edges.get(b)
                 if up is not None and up.parent == a:  # a is b's parent: b's pose in a
                     step = up.at(stamp, self.tolerance)

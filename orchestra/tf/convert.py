@@ -5,7 +5,8 @@ float seconds, accepting rospy-style Time or plain numbers) are testable without
 """
 from __future__ import annotations
 
-from typing import Any, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 from orchestra.tf.transformations import Transform
 

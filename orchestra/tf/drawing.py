@@ -7,8 +7,8 @@ the picture needs nothing but a browser.
 """
 from __future__ import annotations
 
+from collections.abc import Mapping
 from html import escape
-from typing import Mapping
 
 BOX_W, BOX_H, GAP_X, GAP_Y, MARGIN = 150, 40, 30, 70, 20
 

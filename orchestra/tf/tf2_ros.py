@@ -22,8 +22,13 @@ from typing import Any
 from orchestra.tf import listener as _listener
 from orchestra.tf import transformations as tfm
 from orchestra.tf.broadcaster import StaticTransformBroadcaster, TransformBroadcaster
-from orchestra.tf.buffer import (ConnectivityException, ExtrapolationException,
-                                 LookupException, TransformBuffer, TransformException)
+from orchestra.tf.buffer import (
+    ConnectivityException,
+    ExtrapolationException,
+    LookupException,
+    TransformBuffer,
+    TransformException,
+)
 from orchestra.tf.convert import fill_transform_msg, to_sec, transform_from_msg
 from orchestra.tf.transformations import Transform
 

@@ -11,7 +11,7 @@ library must import in milliseconds inside every node.
 from __future__ import annotations
 
 import math
-from typing import Sequence
+from collections.abc import Sequence
 
 Vector = tuple[float, float, float]
 Quaternion = tuple[float, float, float, float]
@@ -96,16 +96,16 @@ def quaternion_slerp(q0: Sequence[float], q1: Sequence[float], fraction: float) 
     """Spherical interpolation along the short arc (what tf does between two stamped samples)."""
     q0 = normalize(q0)
     q1 = normalize(q1)
-    dot = sum(a * b for a, b in zip(q0, q1))
+    dot = sum(a * b for a, b in zip(q0, q1, strict=False))
     if dot < 0.0:  # the short way round
         q1 = (-q1[0], -q1[1], -q1[2], -q1[3])
         dot = -dot
     if dot > 0.9995:  # nearly parallel: lerp is exact enough and avoids dividing by ~0
-        return normalize(tuple(a + fraction * (b - a) for a, b in zip(q0, q1)))
+        return normalize(tuple(a + fraction * (b - a) for a, b in zip(q0, q1, strict=False)))
     theta = math.acos(min(1.0, dot))
     s0 = math.sin((1.0 - fraction) * theta) / math.sin(theta)
     s1 = math.sin(fraction * theta) / math.sin(theta)
-    return tuple(s0 * a + s1 * b for a, b in zip(q0, q1))  # type: ignore[return-value]
+    return tuple(s0 * a + s1 * b for a, b in zip(q0, q1, strict=False))  # type: ignore[return-value]
 
 
 def compose(a: Transform, b: Transform) -> Transform:
@@ -127,7 +127,7 @@ def inverse(t: Transform) -> Transform:
 def interpolate(a: Transform, b: Transform, fraction: float) -> Transform:
     """Linear translation, spherical rotation, ``fraction`` in [0, 1] from ``a`` to ``b``."""
     (at, aq), (bt, bq) = a, b
-    trans = tuple(x + fraction * (y - x) for x, y in zip(at, bt))
+    trans = tuple(x + fraction * (y - x) for x, y in zip(at, bt, strict=False))
     return (trans, quaternion_slerp(aq, bq, fraction))  # type: ignore[return-value]
 
 

@@ -114,7 +114,7 @@ def run_all(jobs: list[tuple[tuple[str, ...], list[str], dict[str, str]]], timeo
     procs = [subprocess.Popen(argv, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                               text=True) for _, argv, env in jobs]
     results = []
-    for (label, _, _), proc in zip(jobs, procs):
+    for (label, _, _), proc in zip(jobs, procs, strict=False):
         try:
             out, err = proc.communicate(timeout=timeout)
         except subprocess.TimeoutExpired:

@@ -24,7 +24,7 @@ def captured(*argv):
             main(["launch", *argv])
         except SystemExit as exc:
             code = exc.code
-    return out.getvalue() if code == 0 else {"error": "exit %s: %s" % (code, err.getvalue())}
+    return out.getvalue() if code == 0 else {"error": f"exit {code}: {err.getvalue()}"}
 
 
 report = {}

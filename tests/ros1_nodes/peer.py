@@ -117,8 +117,8 @@ def run_serve(service, type_name):
         calls.append(1)
         if type_name.endswith("SetBool"):
             if not req.data:
-                raise ValueError("refused by %s" % impl)
-            return cls._response_class(success=True, message="%s call %d" % (impl, len(calls)))
+                raise ValueError(f"refused by {impl}")
+            return cls._response_class(success=True, message=f"{impl} call {len(calls)}")
         return cls._response_class()
 
     rospy.init_node(opts.name, anonymous=opts.anonymous)

@@ -22,7 +22,7 @@ def captured(fn, *args):
         with contextlib.redirect_stdout(out):
             fn(*args)
     except SystemExit as exc:
-        return {"error": "exit %s: %s" % (exc.code, out.getvalue())}
+        return {"error": f"exit {exc.code}: {out.getvalue()}"}
     return out.getvalue()
 
 

@@ -6,8 +6,9 @@ import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.realpath(__file__)), "..", "src"))
 
-import orchestra.node as node  # noqa: E402
 from learning_tf_core import nodes  # noqa: E402
+
+import orchestra.node as node  # noqa: E402
 
 
 def main() -> None:

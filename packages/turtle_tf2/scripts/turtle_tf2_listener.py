@@ -10,8 +10,9 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.realpath(__file__)), "..
 
 
 def main() -> int:
-    import orchestra.node as node
     from turtle_tf2_core import nodes
+
+    import orchestra.node as node
 
     node.init_node("tf2_turtle")
     nodes.follow("turtle1", str(node.get_param("turtle", "turtle2")).strip("/"))

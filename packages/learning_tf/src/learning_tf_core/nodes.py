@@ -7,11 +7,10 @@ service, then steer it towards the leader at 10 Hz from tf lookups.
 from __future__ import annotations
 
 import orchestra.node as node
+from learning_tf_core.follow import WORLD_FRAME, follow_command, pose_to_transform
 from orchestra.node.exceptions import ROSInterruptException, ServiceException
 from orchestra.node.msg import get_message_class, get_service_class
 from orchestra.tf import TransformBroadcaster, TransformException, TransformListener
-
-from learning_tf_core.follow import WORLD_FRAME, follow_command, pose_to_transform
 
 FOLLOW_RATE_HZ = 10.0
 

@@ -17,13 +17,14 @@ from __future__ import annotations
 import collections
 import logging
 import threading
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 log = logging.getLogger(__name__)
 
 
 class LocalSubscription:
-    def __init__(self, bus: "LocalBus", topic: str, msg_type: str,
+    def __init__(self, bus: LocalBus, topic: str, msg_type: str,
                  callback: Callable[[Any], None], queue_size: int):
         self.bus, self.topic, self.msg_type, self.callback = bus, topic, msg_type, callback
         self._queue: collections.deque = collections.deque(maxlen=max(1, queue_size or 1))

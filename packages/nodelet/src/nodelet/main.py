@@ -31,8 +31,8 @@ def _srv(name: str):
 
 
 def run_manager() -> int:
-    from orchestra import node
     from nodelet.manager import LoadError, Manager, uri_alive
+    from orchestra import node
 
     node.init_node("manager")
     manager = Manager()
@@ -40,7 +40,7 @@ def run_manager() -> int:
                                       _srv("nodelet/NodeletList"))
 
     def on_load(req):
-        remaps = dict(zip(req.remap_source_args, req.remap_target_args))
+        remaps = dict(zip(req.remap_source_args, req.remap_target_args, strict=False))
         try:
             manager.load(req.name, req.type, remaps, list(req.my_argv), req.bond_id)
         except LoadError as exc:
@@ -149,8 +149,8 @@ def run_loader(type_name: str, manager_name: str, extra: list[str]) -> int:
 
 
 def run_standalone(type_name: str, extra: list[str]) -> int:
-    from orchestra import node
     from nodelet.plugins import load_plugin
+    from orchestra import node
 
     node.init_node("nodelet")
     name = node.get_name()

@@ -28,11 +28,11 @@ def mat_mul(a: Matrix, b: Matrix) -> Matrix:
 
 
 def transpose(a: Matrix) -> Matrix:
-    return [list(row) for row in zip(*a)]
+    return [list(row) for row in zip(*a, strict=False)]
 
 
 def mat_add(a: Matrix, b: Matrix) -> Matrix:
-    return [[x + y for x, y in zip(ra, rb)] for ra, rb in zip(a, b)]
+    return [[x + y for x, y in zip(ra, rb, strict=False)] for ra, rb in zip(a, b, strict=False)]
 
 
 def diag(*values: float) -> Matrix:

@@ -7,7 +7,8 @@ this testable without a master or sockets.
 """
 from __future__ import annotations
 
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 from rosout_core.logfile import RosoutLog, format_line
 

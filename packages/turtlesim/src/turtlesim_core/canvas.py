@@ -7,7 +7,7 @@ which gives Qt-like round caps and joins for the short per-tick segments turtles
 from __future__ import annotations
 
 import math
-from typing import Iterable, Sequence
+from collections.abc import Iterable, Sequence
 
 Color = tuple[int, int, int]
 
@@ -66,13 +66,13 @@ class Canvas:
                 if (ay <= sy < by) or (by <= sy < ay):
                     xs.append(ax + (sy - ay) * (bx - ax) / (by - ay))
             xs.sort()
-            for a, b in zip(xs[0::2], xs[1::2]):
+            for a, b in zip(xs[0::2], xs[1::2], strict=False):
                 xa, xb = max(0, int(math.ceil(a - 0.5))), min(self.width - 1, int(math.floor(b - 0.5)))
                 if xb >= xa:
                     start = (y * self.width + xa) * 3
                     self.pixels[start:(y * self.width + xb + 1) * 3] = c * (xb - xa + 1)
 
-    def copy(self) -> "Canvas":
+    def copy(self) -> Canvas:
         other = Canvas.__new__(Canvas)
         other.width, other.height, other.pixels = self.width, self.height, bytearray(self.pixels)
         return other

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import base64
 import os
-from typing import Callable
+from collections.abc import Callable
 
 from turtlesim_core.canvas import Canvas
 from turtlesim_core.png import encode_png
