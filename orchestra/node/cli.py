@@ -203,6 +203,135 @@ def node_kill(names: tuple[str, ...], kill_all: bool) -> None:
     click.echo("killed")
 
 
+class _Unknown(OrchestraError):
+    """Names matching no node of the launch nor of the graph: a user mistake (exit 2)."""
+
+
+def _launch_here(uri: str) -> dict | None:
+    """The running orchestra launch (of this user) whose master is at ``uri``."""
+    from orchestra.supervise.status import launches_at
+
+    found = launches_at(uri)
+    return found[0] if found else None
+
+
+def _control(op: str, names: tuple[str, ...], force: bool = False, sig: str = "",
+             timeout: float = 30.0) -> None:
+    """Ask the launch at ROS_MASTER_URI to act on NAMES, then wait until they settled.
+
+    Names the launch does not know but the master does (nodes started by something else)
+    are stopped the way ``node kill`` does; anything else is unknown: exit 2, nothing done.
+    """
+    from orchestra.supervise.control import did_you_mean, matches
+    from orchestra.supervise.status import request
+
+    uri = _master_uri()
+    launch = _launch_here(uri)
+    ours = [n["name"] for n in launch["nodes"]] if launch else []
+    mine = [n for n in names if matches(n, ours)]
+    foreign = [n for n in names if n not in mine]
+    if foreign:
+        graph: list[str] = []
+        if op == "stop":
+            try:
+                graph = introspect.system_state(uri).nodes
+            except (OSError, introspect.GraphError, OrchestraError):
+                graph = []
+        missing = [n for n in foreign if _global(n) not in graph]
+        if missing:
+            where = "this launch" if launch else f"any orchestra launch at {uri}"
+            raise _Unknown("\n".join(f"no node {_global(n)} in {where}"
+                                      f"{did_you_mean(_global(n), ours + graph)}"
+                                      for n in missing))
+    answer: dict = {"ok": True, "done": []}
+    if mine:
+        before = {n["name"]: n for n in launch["nodes"]} if launch else {}
+        body: dict = {"op": op, "names": list(mine), "force": force}
+        if sig:
+            body["signal"] = sig
+        try:
+            answer = request(launch["socket"], body)
+        except (OSError, ValueError) as exc:
+            raise CommandFailed(f"the launch did not answer: {exc}") from None
+        if not answer.get("ok"):
+            raise (_Unknown if answer.get("unknown") else CommandFailed)(answer.get("error"))
+        if op != "signal":
+            _wait_settled(launch["socket"], [n for n, _ in answer["done"]], before, timeout)
+    for name in foreign:
+        click.echo(f"killing {_global(name)} (not started by orchestra: asked to shut down)")
+        try:
+            introspect.kill_node(uri, _global(name))
+        except introspect.GraphError as exc:
+            raise CommandFailed(str(exc)) from None
+
+
+def _wait_settled(path: str, names: list[str], before: dict, timeout: float) -> None:
+    """Poll the launch until none of ``names`` is STOPPING/STARTING; print where each ended."""
+    from orchestra.supervise.status import query
+
+    deadline = time.monotonic() + timeout
+    while True:
+        nodes = {n["name"]: n for n in query(path)["nodes"]}
+        busy = [n for n in names if nodes[n]["state"] in ("STOPPING", "STARTING")]
+        if not busy or time.monotonic() > deadline:
+            break
+        time.sleep(0.05)
+    for name in names:
+        now, old = nodes[name], before.get(name, {})
+        pid = f" (pid {old.get('pid')} -> {now['pid']})" if old.get("pid") and now["pid"] \
+            else (f" (pid {now['pid']})" if now["pid"] else "")
+        click.echo(f"{name}: {now['state']}{pid}" + (f" - {now['reason']}" if now["reason"]
+                                                      and now["state"] != "RUNNING" else ""))
+    if busy:
+        raise CommandFailed(f"still {nodes[busy[0]]['state']} after {timeout:g} s: "
+                            + ", ".join(busy))
+
+
+_FORCE = click.option("-f", "--force", is_flag=True,
+                      help="Also stop required nodes (whose end otherwise stops the launch).")
+_TIMEOUT = click.option("--timeout", type=click.FloatRange(min=0), default=30.0,
+                        show_default=True, help="Seconds to wait for the nodes to settle.")
+
+
+@node.command("stop")
+@click.argument("names", nargs=-1, required=True)
+@_FORCE
+@_TIMEOUT
+def node_stop(names: tuple[str, ...], force: bool, timeout: float) -> None:
+    """Stop NAMES of the launch at ROS_MASTER_URI; the rest keeps running.
+
+    A NAME is a node, a namespace (every node below it) or a glob (/cam*). A stopped node is
+    STOPPED until started again. Nodes not started by orchestra are asked to shut down, as
+    ``node kill`` does.
+    """
+    _control("stop", names, force=force, timeout=timeout)
+
+
+@node.command("start")
+@click.argument("names", nargs=-1, required=True)
+@_TIMEOUT
+def node_start(names: tuple[str, ...], timeout: float) -> None:
+    """Start NAMES again (stopped by hand, ended or failed) in the launch at ROS_MASTER_URI."""
+    _control("start", names, timeout=timeout)
+
+
+@node.command("restart")
+@click.argument("names", nargs=-1, required=True)
+@_TIMEOUT
+def node_restart(names: tuple[str, ...], timeout: float) -> None:
+    """Stop NAMES (SIGINT, then SIGTERM, SIGKILL) and start them again; the rest runs on."""
+    _control("restart", names, timeout=timeout)
+
+
+@node.command("signal")
+@click.argument("sig", metavar="SIGNAL")
+@click.argument("names", nargs=-1, required=True)
+def node_signal(sig: str, names: tuple[str, ...]) -> None:
+    """Send SIGNAL (USR1, SIGHUP, 10...) to NAMES of the launch at ROS_MASTER_URI."""
+    _control("signal", names, sig=sig)
+    click.echo(f"sent {sig} to {', '.join(names)}")
+
+
 @node.command("ping")
 @click.argument("name")
 @click.option("-c", "count", type=click.IntRange(min=1), default=1, show_default=True,

@@ -82,32 +82,48 @@ def run_plan(plan: Any, options: dict[str, Any]) -> int:
 @click.option("--master", "use_master", is_flag=True,
               help="Ask the launches registered on the master at ROS_MASTER_URI "
                    "(/roslaunch/uris), also those of other users and machines.")
-def status(as_json: bool, socket_path: str | None, use_master: bool) -> int:
-    """Show the nodes of the running launches: state, pid, restarts, uptime, CPU%, RSS.
+@click.option("--all", "all_launches", is_flag=True,
+              help="Every launch of this user on this machine, whatever its master.")
+def status(as_json: bool, socket_path: str | None, use_master: bool,
+           all_launches: bool) -> int:
+    """Show the nodes of the running launch: state, pid, restarts, uptime, CPU%, RSS, and
+    why a node is not running.
 
-    By default every launch of this user on this machine answers over its local socket.
+    By default the launch of this user whose master is at ROS_MASTER_URI answers over its
+    local socket (as rosnode/rostopic talk to the ROS_MASTER_URI graph only).
     """
-    from orchestra.supervise.status import launches_on_master, query, running_launches, table_lines
+    from orchestra.master import master_uri_from_env
+    from orchestra.supervise.status import (
+        launches_at,
+        launches_on_master,
+        query,
+        running_launches,
+        table_lines,
+    )
 
+    uri = master_uri_from_env()
     if socket_path:
         try:
             launches = [query(socket_path)]
         except OSError as exc:
             raise click.ClickException(f"no launch answers at {socket_path}: {exc}") from None
     elif use_master:
-        from orchestra.master import master_uri_from_env
-
         try:
-            launches = launches_on_master(master_uri_from_env())
+            launches = launches_on_master(uri)
         except OSError as exc:
             raise click.ClickException(str(exc)) from None
-    else:
+    elif all_launches:
         launches = running_launches()
+    else:
+        launches = launches_at(uri)
     if as_json:
         click.echo(json.dumps(launches if not socket_path else launches[0], indent=1))
         return 0
     if not launches:
-        click.echo("no running orchestra launch", err=True)
+        others = 0 if (socket_path or use_master or all_launches) else len(running_launches())
+        hint = (f" at {uri} ({others} other launch(es) of yours run on other masters: "
+                "orchestra status --all)") if others else ""
+        click.echo(f"no running orchestra launch{hint}", err=True)
         return 1
     for i, launch in enumerate(launches):
         if i:

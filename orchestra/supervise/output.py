@@ -8,6 +8,7 @@ prefixed with the node name so interleaved nodes stay readable.
 """
 from __future__ import annotations
 
+import collections
 import os
 import sys
 import zlib
@@ -16,6 +17,7 @@ from typing import BinaryIO
 from orchestra.supervise.process import OutputMode
 
 MAX_LINE = 65536   # console bytes held back waiting for a newline
+RECENT_LINES = 200  # per node, for the interactive view and exit reasons
 
 _COLOURS = (31, 32, 33, 34, 35, 36, 91, 92, 93, 94, 95, 96)
 
@@ -183,6 +185,10 @@ class NodeOutput:
         self.screen = screen
         self._prefix = screen.prefix(name)
         self._partial = {"out": b"", "err": b""}
+        # the last lines of both streams (whatever the output mode): what the interactive
+        # view shows for a node and how an exit is explained (MemoryError under memory-limit)
+        self.recent: collections.deque[bytes] = collections.deque(maxlen=RECENT_LINES)
+        self.muted = False               # by hand: output still logged, not shown
         self.files: dict[str, RotatingFile] = {}
         if log_dir and log_name and mode in (OutputMode.LOG, OutputMode.BOTH):
             for stream, suffix in (("out", "stdout"), ("err", "stderr")):
@@ -204,27 +210,31 @@ class NodeOutput:
                 log.write(data)
             except OSError:
                 pass
-        if not self._to_screen(stream):
-            return
         buf = self._partial[stream] + data
         cut = buf.rfind(b"\n")
         if cut < 0:
             if len(buf) > MAX_LINE:      # no newline for too long (progress bars): show it
                 self._partial[stream] = b""
-                self.screen.write_lines(self._prefix + buf + b"\n", stream)
+                self._lines(stream, [buf])
             else:
                 self._partial[stream] = buf
             return
         self._partial[stream] = buf[cut + 1:]
-        lines = buf[:cut].split(b"\n")
-        self.screen.write_lines(b"".join(self._prefix + line + b"\n" for line in lines), stream)
+        self._lines(stream, buf[:cut].split(b"\n"))
+
+    def _lines(self, stream: str, lines: list[bytes]) -> None:
+        """Complete lines: kept as the node's recent output, shown unless muted or logged."""
+        self.recent.extend(lines)
+        if self._to_screen(stream) and not self.muted:
+            self.screen.write_lines(b"".join(self._prefix + line + b"\n" for line in lines),
+                                    stream)
 
     def end(self, stream: str) -> None:
         """The pipe reached EOF: a last line without newline is still shown."""
         rest = self._partial[stream]
         self._partial[stream] = b""
-        if rest and self._to_screen(stream):
-            self.screen.write_lines(self._prefix + rest + b"\n", stream)
+        if rest:
+            self._lines(stream, [rest])
 
     def close(self) -> None:
         for log in self.files.values():

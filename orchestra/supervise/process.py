@@ -5,6 +5,13 @@ only knows "alive or not":
 
     STARTING -> RUNNING -> (EXITED | BACKOFF -> STARTING ... | FAILED)
                 RUNNING -> STOPPING -> EXITED
+    by hand:    RUNNING -> STOPPING -> STOPPED -> STARTING ...   (stop, then start)
+                RUNNING -> STOPPING -> STARTING -> RUNNING       (restart)
+                EXITED | FAILED | BACKOFF -> STARTING              (start)
+
+STOPPED is its own state because a node stopped by hand differs from one that ended: it is
+not respawned, a required one does not end the launch, and the launch keeps running for it
+to be started again (rosmon's and supervisorctl's model).
 
 This module holds data and pure rules only; the Supervisor does the side effects and calls
 ``ManagedProcess.transition`` so that every change is checked and logged in one place.
@@ -26,6 +33,7 @@ class State(str, enum.Enum):
     BACKOFF = "BACKOFF"      # died, waiting for its respawn delay
     STOPPING = "STOPPING"    # we asked it to stop (SIGINT, then SIGTERM, then SIGKILL)
     EXITED = "EXITED"        # ended and will not be restarted (stopped, or ended by itself)
+    STOPPED = "STOPPED"      # stopped by hand; waits to be started by hand
     FAILED = "FAILED"        # could not be spawned, or crash-looped past the limit
 
     def __str__(self) -> str:
@@ -37,10 +45,11 @@ TERMINAL = frozenset({State.EXITED, State.FAILED})
 _ALLOWED: dict[State, frozenset[State]] = {
     State.STARTING: frozenset({State.RUNNING, State.FAILED, State.EXITED}),
     State.RUNNING: frozenset({State.STOPPING, State.EXITED, State.BACKOFF, State.FAILED}),
-    State.BACKOFF: frozenset({State.STARTING, State.EXITED}),
-    State.STOPPING: frozenset({State.EXITED}),
-    State.EXITED: frozenset(),
-    State.FAILED: frozenset(),
+    State.BACKOFF: frozenset({State.STARTING, State.EXITED, State.STOPPED}),
+    State.STOPPING: frozenset({State.EXITED, State.STOPPED, State.STARTING}),
+    State.EXITED: frozenset({State.STARTING}),
+    State.FAILED: frozenset({State.STARTING}),
+    State.STOPPED: frozenset({State.STARTING, State.EXITED}),
 }
 
 
@@ -48,6 +57,22 @@ class OutputMode(str, enum.Enum):
     SCREEN = "screen"   # stdout and stderr on the console, prefixed with the node name
     LOG = "log"         # stdout to the log file; stderr to the log file AND the console
     BOTH = "both"       # both streams to the log files and the console
+
+
+@dataclass(frozen=True)
+class Limits:
+    """rosmon's per-node resource attributes, as the kernel is asked to enforce them.
+
+    ``memory`` is bytes of address space (RLIMIT_AS; 0 = none), ``cpu`` a fraction of one
+    core (cgroup v2 ``cpu.max``; 0 = none), ``coredumps`` lifts RLIMIT_CORE to unlimited.
+    """
+
+    memory: int = 0
+    cpu: float = 0.0
+    coredumps: bool = False
+
+    def __bool__(self) -> bool:
+        return bool(self.memory or self.cpu or self.coredumps)
 
 
 @dataclass(frozen=True)
@@ -70,6 +95,7 @@ class ProcessSpec:
     sigint_timeout: float = 15.0
     sigterm_timeout: float = 2.0
     location: str | None = None
+    limits: Limits = field(default_factory=Limits)
 
 
 @dataclass(frozen=True)
@@ -115,6 +141,7 @@ class ManagedProcess:
     exit_code: int | None = None
     reason: str = ""                     # why it is FAILED / EXITED, for status and errors
     start_index: int = 0                 # order of first start (stop goes in reverse)
+    after_stop: State | None = None      # by hand: STOPPED (stop) or STARTING (restart)
     history: list[tuple[float, State]] = field(default_factory=list)
 
     def transition(self, new: State, reason: str = "") -> None:

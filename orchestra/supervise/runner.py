@@ -395,6 +395,7 @@ def _set_title(title: str) -> None:
 
 def run_plan(plan: LaunchPlan, options: Mapping[str, Any]) -> int:
     """Run the plan's nodes under supervision until stopped; returns orchestra's exit code."""
+    from orchestra.supervise import control
     from orchestra.supervise.reaper import Watchdog
     from orchestra.supervise.rosout import core_nodes, resolve_core_executables
     from orchestra.supervise.rpc import LaunchRPCServer, uris_param
@@ -444,7 +445,9 @@ def run_plan(plan: LaunchPlan, options: Mapping[str, Any]) -> int:
             return snapshot(supervisor.procs, stats, info)
 
         try:
-            server: StatusServer | None = StatusServer(supervisor.loop, make_snapshot)
+            server: StatusServer | None = StatusServer(
+                supervisor.loop, make_snapshot,
+                control=lambda request: control.handle(supervisor, request))
         except OSError as exc:       # status is a convenience: never a reason not to run
             logger.warning("no status socket (orchestra status will not see this launch): %s",
                            exc)

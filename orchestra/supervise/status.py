@@ -106,16 +106,21 @@ def _size(rss: int | None) -> str:
 
 
 def table_lines(nodes: list[dict[str, Any]]) -> list[str]:
-    """One compact line per node: name, state, pid, restarts, uptime, CPU%, RSS."""
+    """One compact line per node: name, state, pid, restarts, uptime, CPU%, RSS, and why a
+    node is not running (stopped by hand, exit code, crash loop) when any is not."""
     width = max([len("NODE")] + [len(n["name"]) for n in nodes])
+    reasons = [n.get("reason") or "" if n["state"] != State.RUNNING.value else ""
+               for n in nodes]
+    tail = "  REASON" if any(reasons) else ""
     lines = [f"{'NODE':<{width}}  {'STATE':<8} {'PID':>7} {'RESTARTS':>8} {'UPTIME':>8} "
-             f"{'CPU%':>6} {'RSS':>7}"]
-    for n in nodes:
+             f"{'CPU%':>6} {'RSS':>7}{tail}"]
+    for n, reason in zip(nodes, reasons, strict=True):
         cpu = "-" if n["cpu_percent"] is None else f"{n['cpu_percent']:.1f}"
         pid = "-" if n["pid"] is None else str(n["pid"])
         uptime = _duration(n["uptime"]) if n["pid"] is not None else "-"
+        why = f"  {reason}" if tail and reason else ""
         lines.append(f"{n['name']:<{width}}  {n['state']:<8} {pid:>7} {n['restarts']:>8} "
-                     f"{uptime:>8} {cpu:>6} {_size(n['rss']):>7}")
+                     f"{uptime:>8} {cpu:>6} {_size(n['rss']):>7}{why}")
     return lines
 
 
@@ -137,35 +142,96 @@ def footer_lines(nodes: list[dict[str, Any]], max_lines: int) -> list[str]:
 
 
 class StatusServer:
-    """Serves ``snapshot()`` on a Unix socket from the supervisor's own loop (no thread)."""
+    """The launch's user-only control socket, served from the supervisor's loop (no thread).
+
+    A client sends one JSON document on one line and reads one JSON line back:
+    ``{"op": "status"}`` answers the snapshot; any other op goes to ``control`` (see
+    control.py). Connections are read without blocking, so two clients at once, a client
+    that dies mid-request, or garbage on the socket cost the launch nothing: each is
+    answered or dropped on its own, within ``timeout`` seconds.
+    """
+
+    MAX_REQUEST = 1 << 20
 
     def __init__(self, loop: EventLoop, make_snapshot: Callable[[], dict[str, Any]],
-                 path: str | None = None):
+                 path: str | None = None,
+                 control: Callable[[dict[str, Any]], dict[str, Any]] | None = None,
+                 timeout: float = 2.0):
         self.path = path or os.path.join(runtime_dir(), f"{os.getpid()}.sock")
         if os.path.exists(self.path):
             os.unlink(self.path)
         self._sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
         self._sock.bind(self.path)
         os.chmod(self.path, stat.S_IRUSR | stat.S_IWUSR)
-        self._sock.listen(8)
+        self._sock.listen(16)
         self._sock.setblocking(False)
         self._loop = loop
         self._make = make_snapshot
+        self._control = control
+        self._timeout = timeout
+        self._conns: dict[int, tuple[socket.socket, bytearray, Any]] = {}
         loop.add_reader(self._sock.fileno(), self._accept)
 
     def _accept(self) -> None:
         try:
             conn, _ = self._sock.accept()
-        except (BlockingIOError, OSError):
+        except OSError:
             return
-        with conn:
+        conn.setblocking(False)
+        fd = conn.fileno()
+        timer = self._loop.call_later(self._timeout, lambda: self._drop(fd))
+        self._conns[fd] = (conn, bytearray(), timer)
+        self._loop.add_reader(fd, lambda: self._read(fd))
+
+    def _read(self, fd: int) -> None:
+        conn, buf, _ = self._conns[fd]
+        try:
+            data = conn.recv(65536)
+        except BlockingIOError:
+            return
+        except OSError:
+            data = b""
+        if not data:                          # the client went away mid-request
+            self._drop(fd)
+            return
+        buf += data
+        if b"\n" not in buf and len(buf) <= self.MAX_REQUEST:
+            return
+        line = bytes(buf.split(b"\n", 1)[0])
+        answer = self._answer(line)
+        try:
+            conn.setblocking(True)
             conn.settimeout(1.0)
-            try:
-                conn.sendall(json.dumps(self._make()).encode() + b"\n")
-            except OSError:
-                pass
+            conn.sendall(json.dumps(answer).encode() + b"\n")
+        except OSError:
+            pass
+        self._drop(fd)
+
+    def _answer(self, line: bytes) -> dict[str, Any]:
+        try:
+            request = json.loads(line)
+        except ValueError:
+            return {"ok": False, "error": "not a JSON request"}
+        if not isinstance(request, dict):
+            return {"ok": False, "error": "a request is a JSON object with an 'op'"}
+        if request.get("op") == "status":
+            return self._make()
+        if self._control is None:
+            return {"ok": False, "error": "this launch takes no control requests"}
+        return self._control(request)
+
+    def _drop(self, fd: int) -> None:
+        entry = self._conns.pop(fd, None)
+        if entry is None:
+            return
+        conn, _, timer = entry
+        timer.cancel()
+        self._loop.remove_reader(fd)
+        conn.close()
 
     def close(self) -> None:
+        for fd in list(self._conns):
+            self._drop(fd)
         self._loop.remove_reader(self._sock.fileno())
         self._sock.close()
         try:
@@ -174,11 +240,12 @@ class StatusServer:
             pass
 
 
-def query(path: str, timeout: float = 3.0) -> dict[str, Any]:
-    """Ask the launch behind socket ``path`` for its snapshot (OSError when it is gone)."""
+def request(path: str, doc: dict[str, Any], timeout: float = 3.0) -> dict[str, Any]:
+    """Send one request to the launch behind socket ``path`` (OSError when it is gone)."""
     with socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as sock:
         sock.settimeout(timeout)
         sock.connect(path)
+        sock.sendall(json.dumps(doc).encode() + b"\n")
         chunks = []
         while True:
             data = sock.recv(65536)
@@ -186,6 +253,11 @@ def query(path: str, timeout: float = 3.0) -> dict[str, Any]:
                 break
             chunks.append(data)
     return json.loads(b"".join(chunks))
+
+
+def query(path: str, timeout: float = 3.0) -> dict[str, Any]:
+    """Ask the launch behind socket ``path`` for its snapshot (OSError when it is gone)."""
+    return request(path, {"op": "status"}, timeout)
 
 
 def running_launches(directory: str | None = None) -> list[dict[str, Any]]:
@@ -197,7 +269,7 @@ def running_launches(directory: str | None = None) -> list[dict[str, Any]]:
             continue
         path = os.path.join(directory, name)
         try:
-            found.append(query(path))
+            found.append({**query(path), "socket": path})
         except (ConnectionRefusedError, FileNotFoundError):
             pid = name[:-5]
             if pid.isdigit() and not psutil.pid_exists(int(pid)):
@@ -208,6 +280,35 @@ def running_launches(directory: str | None = None) -> list[dict[str, Any]]:
         except (OSError, ValueError):
             continue
     return found
+
+
+_LOOPBACK = {"localhost", "127.0.0.1", "::1", "localhost.localdomain", "ip6-localhost"}
+
+
+def _master_key(uri: str) -> tuple[str, int | None]:
+    """(host, port) of a master URI with every name of this machine as one host."""
+    import urllib.parse
+
+    parts = urllib.parse.urlsplit(uri)
+    host = (parts.hostname or "localhost").lower()
+    if host in _LOOPBACK or host.startswith("127.") or host == socket.gethostname().lower():
+        host = "localhost"
+    try:
+        port = parts.port
+    except ValueError:
+        port = None
+    return host, port
+
+
+def same_master(a: str, b: str) -> bool:
+    """True when two master URIs name the same master (localhost == 127.0.0.1 == hostname)."""
+    return _master_key(a) == _master_key(b)
+
+
+def launches_at(master_uri: str, directory: str | None = None) -> list[dict[str, Any]]:
+    """The running launches of this user whose master is the one at ``master_uri``."""
+    return [doc for doc in running_launches(directory)
+            if same_master(str(doc.get("master_uri") or ""), master_uri)]
 
 
 def launches_on_master(master_uri: str, timeout: float = 3.0) -> list[dict[str, Any]]:

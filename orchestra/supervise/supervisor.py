@@ -24,6 +24,14 @@ from dataclasses import dataclass, field
 
 import psutil
 
+from orchestra.supervise.limits import (
+    cgroup_unavailable,
+    cpu_cgroup,
+    explain_exit,
+    join_cgroup,
+    remove_cgroup,
+    rlimit_setup,
+)
 from orchestra.supervise.loop import EventLoop, Timer
 from orchestra.supervise.output import NodeOutput, Screen
 from orchestra.supervise.process import (
@@ -114,6 +122,9 @@ class Supervisor:
         self._signal_count = 0
         self._pid = os.getpid()
         self.started_at = time.monotonic()
+        self._cgroups: dict[str, str] = {}
+        self._cgroup_problem = (cgroup_unavailable()
+                                if any(s.limits.cpu for s in specs) else None)
 
     # ------------------------------------------------------------------ public API
 
@@ -165,9 +176,88 @@ class Supervisor:
                 self._escalate(proc, signal.SIGKILL)
 
     def done(self) -> bool:
-        if self.keep_alive and not self.stopping:
+        """The run is over: everything ended, and nothing waits to be started by hand."""
+        if self.stopping:
+            return all(p.state in TERMINAL or p.state == State.STOPPED for p in self.procs)
+        if self.keep_alive or any(p.state == State.STOPPED for p in self.procs):
             return False
         return all(p.state in TERMINAL for p in self.procs)
+
+    # ------------------------------------------------------------------ control by hand
+
+    def stop_process(self, name: str, force: bool = False) -> str:
+        """Stop one process by hand: it becomes STOPPED and is not respawned.
+
+        A required process is refused unless ``force``: stopping it is what ends a launch,
+        so doing it by accident must not be one keystroke away. Returns what happened.
+        """
+        proc = self.by_name(name)
+        if proc.spec.required and not force:
+            raise ControlError(f"{name} is required (its end stops the launch); "
+                               "use --force to stop it anyway")
+        if self.stopping:
+            raise ControlError("the launch is stopping")
+        if proc.state == State.BACKOFF:
+            self._cancel_timer(proc)
+            proc.transition(State.STOPPED, "stopped by hand while waiting to respawn")
+        elif proc.state in (State.RUNNING, State.STARTING) and name in self._children:
+            self._stop_one(proc, State.STOPPED, "stopped by hand")
+        elif proc.state == State.STOPPING:
+            proc.after_stop = State.STOPPED
+        else:
+            return f"{name} is not running ({proc.state})"
+        self._changed()
+        return f"stopping {name}"
+
+    def start_process(self, name: str) -> str:
+        """Start one process that is not running (stopped by hand, ended or failed)."""
+        proc = self.by_name(name)
+        if self.stopping:
+            raise ControlError("the launch is stopping")
+        if proc.state == State.STOPPING:
+            proc.after_stop = State.STARTING
+            return f"{name} is stopping; it starts again once it has"
+        if proc.state not in (State.STOPPED, State.EXITED, State.FAILED, State.BACKOFF):
+            return f"{name} is already running"
+        self._cancel_timer(proc)
+        proc.short_runs = 0
+        proc.transition(State.STARTING, "started by hand")
+        self._spawn(proc)
+        return f"started {name}"
+
+    def restart_process(self, name: str) -> str:
+        """Stop (SIGINT, escalating) and start again one process; a stopped one just starts."""
+        proc = self.by_name(name)
+        if self.stopping:
+            raise ControlError("the launch is stopping")
+        if proc.state in (State.RUNNING, State.STARTING) and name in self._children:
+            self._stop_one(proc, State.STARTING, "restarting by hand")
+            proc.restarts += 1
+            self._changed()
+            return f"restarting {name}"
+        if proc.state == State.STOPPING:
+            proc.after_stop = State.STARTING
+            return f"{name} is stopping; it starts again once it has"
+        return self.start_process(name)
+
+    def signal_process(self, name: str, signum: int) -> str:
+        """Send ``signum`` to one running process's group (what happens next is its exit)."""
+        proc = self.by_name(name)
+        child = self._children.get(name)
+        if child is None:
+            return f"{name} is not running ({proc.state})"
+        signal_group(child.popen.pid, signum, child.extra)
+        return f"sent {signal.Signals(signum).name} to {name}"
+
+    def _stop_one(self, proc: ManagedProcess, after: State, reason: str) -> None:
+        child = self._children[proc.spec.name]
+        pid = child.popen.pid
+        child.extra = [d for d in descendants([pid]).get(pid, ()) if _pgid(d) != pid]
+        proc.after_stop = after
+        proc.transition(State.STOPPING, reason)
+        signal_group(pid, signal.SIGINT, child.extra)
+        self._set_timer(proc, proc.spec.sigint_timeout,
+                        lambda: self._escalate(proc, signal.SIGTERM))
 
     def run(self, install_signals: bool = True,
             before_start: Callable[[], None] | None = None) -> RunResult:
@@ -199,17 +289,18 @@ class Supervisor:
 
     def _spawn(self, proc: ManagedProcess) -> None:
         spec = proc.spec
-        if proc.state == State.BACKOFF:
-            proc.transition(State.STARTING, "respawn")
+        if proc.state in (State.BACKOFF, State.STOPPING):
+            proc.transition(State.STARTING, "respawn" if proc.state == State.BACKOFF
+                            else "restart")
+        proc.after_stop = None
         argv = list(spec.argv)
-        preexec = None
+        preexec = _chain(child_setup(self._pid) if self.pdeathsig == "preexec" else None,
+                         rlimit_setup(spec.limits))
         try:
             os.makedirs(spec.cwd, exist_ok=True)
             if self.pdeathsig == "setpriv":
                 check_executable(argv[0], spec.env, spec.cwd)
                 argv = [*setpriv_prefix(), *argv]
-            elif self.pdeathsig == "preexec":
-                preexec = child_setup(self._pid)
             popen = subprocess.Popen(
                 argv, cwd=spec.cwd, env={**spec.env, MARK_VARIABLE: self.mark},
                 stdin=None,  # inherited, as roslaunch
@@ -237,6 +328,8 @@ class Supervisor:
         proc.pid = popen.pid
         proc.started_at = time.monotonic()
         proc.exit_code = None
+        if spec.limits.cpu:
+            self._limit_cpu(proc, popen.pid)
         proc.transition(State.RUNNING, f"pid {popen.pid}")
         self.screen.message(f"process[{spec.name}]: started with pid [{popen.pid}]")
         self._changed()
@@ -303,11 +396,21 @@ class Supervisor:
         self._cancel_timer(proc)
         proc.exit_code = code
         uptime = time.monotonic() - (proc.started_at or time.monotonic())
+        if proc.state == State.STOPPING and not self.stopping and proc.after_stop is not None:
+            if proc.after_stop == State.STARTING:
+                self._spawn(proc)
+            else:
+                proc.transition(State.STOPPED, f"stopped by hand ({describe_exit(code)})")
+                self.screen.message(f"process[{spec.name}]: stopped by hand")
+            proc.after_stop = None
+            self._changed()
+            return
         if proc.state == State.STOPPING or self.stopping:
             proc.transition(State.EXITED, f"stopped ({describe_exit(code)})")
             self._changed()
             return
-        described = describe_exit(code)
+        described = explain_exit(spec.limits, self.outputs[spec.name].recent,
+                                 describe_exit(code))
         if spec.required:
             # a required node that finishes cleanly ends the launch successfully (the
             # "run this job, then stop everything" pattern); any other end is a failure
@@ -365,6 +468,22 @@ class Supervisor:
             self._cancel_timer(proc)
 
     # ------------------------------------------------------------------ helpers
+
+    def _limit_cpu(self, proc: ManagedProcess, pid: int) -> None:
+        """Put a freshly spawned process under its cpu-limit, or say why it runs without."""
+        name = proc.spec.name
+        problem = self._cgroup_problem
+        if problem is None:
+            try:
+                group = self._cgroups.get(name) or cpu_cgroup(name, proc.spec.limits.cpu)
+                self._cgroups[name] = group
+                join_cgroup(group, pid)
+                return
+            except OSError as exc:
+                problem = self._cgroup_problem = f"{exc.strerror or exc}"
+        if proc.restarts == 0:
+            self.screen.message(f"orchestra: warning: cpu-limit of {name} not enforced: "
+                                f"{problem}", err=True)
 
     def _log_hint(self, spec: ProcessSpec) -> str:
         """roslaunch's pointer to the log files of a node that died."""
@@ -465,6 +584,8 @@ class Supervisor:
     def _close(self) -> None:
         for output in self.outputs.values():
             output.close()
+        for group in self._cgroups.values():
+            remove_cgroup(group)
         for child in self._children.values():  # only after an internal error
             signal_group(child.popen.pid, signal.SIGKILL, child.extra)
             child.popen.wait()
@@ -481,6 +602,23 @@ class Supervisor:
             result.exit_code = 1
             result.reason = result.reason + "; failed: " + ", ".join(failed)
         return result
+
+
+class ControlError(Exception):
+    """A control request that cannot be done (the message says why); the run goes on."""
+
+
+def _chain(*steps: Callable[[], None] | None) -> Callable[[], None] | None:
+    """One ``preexec_fn`` running the given steps in order (None when there are none)."""
+    todo = [step for step in steps if step is not None]
+    if not todo:
+        return None
+
+    def run() -> None:
+        for step in todo:
+            step()
+
+    return run
 
 
 def _pidfd_open(pid: int) -> int | None:
