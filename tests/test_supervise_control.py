@@ -28,7 +28,8 @@ from harness import wait_for  # noqa: E402
 
 pytestmark = pytest.mark.timeout(60)
 
-IGNORES_SIGINT = "import signal, time; signal.signal(signal.SIGINT, signal.SIG_IGN); time.sleep(100)"
+IGNORES_SIGINT = ("import signal, time; signal.signal(signal.SIGINT, signal.SIG_IGN); "
+                  "print('ready', flush=True); time.sleep(100)")
 ALLOCATES = ("import sys, time; print('allocating', flush=True); blocks = []\n"
              "while True: blocks.append(bytearray(8 << 20))")
 
@@ -208,6 +209,7 @@ def test_control_socket_survives_garbage_dead_and_concurrent_clients(running):
 def test_stop_timeout_kills_a_node_ignoring_sigint_after_that_many_seconds(running):
     run = running([spec("/stubborn", IGNORES_SIGINT, sigint_timeout=1.0, sigterm_timeout=0.0)])
     pid = run.pid("/stubborn")
+    wait_for(lambda: b"ready" in list(run.sup.outputs["/stubborn"].recent))
     started = time.monotonic()
     run.call(lambda: run.sup.stop_process("/stubborn"))
     wait_for(lambda: run.state("/stubborn") == State.STOPPED, timeout=10)
