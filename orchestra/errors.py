@@ -8,6 +8,18 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+# A value quoted in a message is cut to this many characters: a 1 MB attribute must not make
+# a 1 MB error line. Whole messages are cut at MAX_MESSAGE as a backstop.
+MAX_QUOTED = 200
+MAX_MESSAGE = 2000
+
+
+def clip(text: str, limit: int = MAX_QUOTED) -> str:
+    """``text``, or its first ``limit`` characters and a note of its full length."""
+    if len(text) <= limit:
+        return text
+    return f"{text[:limit]}... ({len(text)} chars)"
+
 
 @dataclass(frozen=True)
 class Location:
@@ -26,12 +38,25 @@ class Location:
         return text
 
 
+def offset_location(file: str, text: str | bytes, offset: int) -> Location:
+    """The line and column (1-based) of character/byte ``offset`` of ``text``.
+
+    For errors that only report an offset: a decoding error, a YAML reader error.
+    """
+    offset = max(0, min(offset, len(text)))
+    newline = "\n" if isinstance(text, str) else b"\n"
+    line = text.count(newline, 0, offset) + 1  # type: ignore[arg-type]
+    start = text.rfind(newline, 0, offset) + 1  # type: ignore[arg-type]
+    return Location(file, line, offset - start + 1)
+
+
 class OrchestraError(Exception):
     """Base class of every error that is the user's to fix. ``exit_code`` is what the CLI returns."""
 
     exit_code = 2
 
     def __init__(self, message: str, location: Location | None = None):
+        message = clip(message, MAX_MESSAGE)
         super().__init__(message)
         self.message = message
         self.location = location

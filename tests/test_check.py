@@ -292,18 +292,18 @@ def test_cli_exit_status_and_line_format(ws):
                  '<launch>\n  <arg name="idle" default="1"/>\n</launch>\n')
     env = dict(os.environ)
     proc = run_cli(bad, env=env)
-    assert proc.returncode == 1
+    assert proc.returncode == 2
     assert proc.stdout.startswith(f"{bad}:2:19: error: arg 'nope'")
     assert "Traceback" not in proc.stderr
     assert run_cli(warn, env=env).returncode == 0
-    assert run_cli(warn, "--strict", env=env).returncode == 1
+    assert run_cli(warn, "--strict", env=env).returncode == 2
     assert run_cli(bad, "nope:=1", env=env).returncode == 0
 
 
 def test_cli_json_output_lists_problems_with_positions(ws):
     path = write(ws / "launch", "a.launch", '<launch>\n  <nod/>\n</launch>\n')
     proc = run_cli(path, "--json", env=dict(os.environ))
-    assert proc.returncode == 1
+    assert proc.returncode == 2
     document = json.loads(proc.stdout)
     assert document["problems"] == [{
         "file": path, "line": 2, "column": 3, "severity": "error", "code": "unknown-tag",
@@ -312,7 +312,7 @@ def test_cli_json_output_lists_problems_with_positions(ws):
 
 def test_cli_missing_file_is_reported_not_a_traceback(tmp_path):
     proc = run_cli(str(tmp_path / "none.launch"))
-    assert proc.returncode == 1
+    assert proc.returncode == 2
     assert "launch file not found" in proc.stdout
     assert "Traceback" not in proc.stderr
 
@@ -373,7 +373,7 @@ def test_cli_directory_checks_included_files_through_their_includer(ws):
           '    <arg name="rate" value="5"/>\n  </include>\n</launch>\n')
     write(ws / "launch", "broken.launch", '<launch>\n  <nod/>\n</launch>\n')
     proc = run_cli(str(ws), env=dict(os.environ))
-    assert proc.returncode == 1
+    assert proc.returncode == 2
     # inner.launch on its own would miss 'rate'; through top.launch it is fine
     assert [line.split(":")[0] for line in proc.stdout.splitlines()] == \
         [str(ws / "launch" / "broken.launch")]

@@ -277,3 +277,27 @@ def test_orchestra_launch_reports_bad_yaml_as_one_located_line(tmp_path):
     assert proc.returncode == 2
     assert proc.stderr.startswith(f"orchestra: error: {path}:2:11: YAML tag")
     assert "Traceback" not in proc.stderr
+
+
+@pytest.mark.parametrize("loader", ["SafeLoader", "CSafeLoader"])
+@pytest.mark.parametrize("char", ["\x01", "\x07", "\x7f", "\ufffe"])
+def test_control_character_is_located_to_line_and_column(loader, char, monkeypatch):
+    import yaml as pyyaml
+
+    from orchestra.launch import yaml as front
+
+    if not hasattr(pyyaml, loader):
+        pytest.skip(f"PyYAML built without {loader}")
+    monkeypatch.setattr(front, "_LOADER", getattr(pyyaml, loader))
+    err = error_of(f'launch:\n  - arg: {{name: é€, default: "x{char}y"}}\n')
+    assert err.location == Location("t.launch.yaml", 2, 32)
+    assert "is not allowed" in err.message
+
+
+def test_invalid_utf8_in_a_yaml_launch_file_is_located(tmp_path):
+    path = tmp_path / "bad.launch.yaml"
+    path.write_bytes(b"launch:\n  - arg: {name: a}\n  - arg: {name: b, default: x\xffy}\n")
+    with pytest.raises(OrchestraError) as info:
+        parse_file(str(path))
+    assert info.value.location == Location(str(path), 3, 30)
+    assert "0xff" in info.value.message

@@ -20,7 +20,6 @@ false) are downgraded to warnings: they are real, but they do not break this lau
 from __future__ import annotations
 
 import ast
-import builtins
 import difflib
 import logging
 import os
@@ -31,7 +30,7 @@ from typing import Any
 import networkx
 
 from orchestra.errors import Location, OrchestraError
-from orchestra.launch import substitution
+from orchestra.launch import evaluate, substitution
 from orchestra.launch.entity import Entity
 
 log = logging.getLogger(__name__)
@@ -99,8 +98,7 @@ _ALSO_FOUND_BY_INTERPRETER = frozenset({
 })
 
 # Names an ``$(eval ...)`` expression may use that are not args.
-_EVAL_NAMES = frozenset({"arg", "env", "optenv", "find", "anon", "dirname", "true", "false",
-                         "True", "False", "None"}) | frozenset(dir(builtins))
+_EVAL_NAMES = evaluate.NAMES
 
 
 @dataclass(frozen=True)
@@ -745,11 +743,7 @@ def _substitution_problem(value: str) -> str | None:
         return None
     stripped = value.strip()
     if value.startswith("$(eval ") and value.endswith(")"):
-        try:
-            ast.parse(stripped[7:-1].strip(), mode="eval")
-        except SyntaxError as exc:
-            return f"$(eval) is not a valid expression: {exc.msg}"
-        return None
+        return evaluate.problem(stripped[7:-1])
     try:
         bodies = substitution.collect(value)
     except OrchestraError as exc:

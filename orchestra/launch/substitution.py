@@ -6,21 +6,19 @@ expression evaluated in a sandbox; otherwise ``$(dirname)``, ``$(env)``, ``$(opt
 occurrence), and ``$(find pkg)`` last, because the path written after ``$(find pkg)`` may
 itself come from an arg. There are no escapes: a ``$`` inside ``$(...)`` is an error.
 
-The ``$(eval)`` sandbox: no double underscore anywhere in the expression, no attribute
-starting with ``_``, and only the names roslaunch documents (``arg``, ``env``, ``optenv``,
-``find``, ``anon``, ``dirname``, ``true``/``false``, declared args by bare name) plus a few
-side-effect-free builtins. ``open``, ``__import__``, ``getattr`` and friends do not exist there.
+``$(eval)`` is never given to Python's ``eval``: ``orchestra.launch.evaluate`` interprets a
+whitelisted expression grammar with bounded sizes and work; this module supplies the launch
+functions (``arg``, ``env``, ``optenv``, ``find``, ``anon``, ``dirname``) it calls.
 """
 from __future__ import annotations
 
-import ast
-import builtins
 import os
 import re
 from collections.abc import Callable, Mapping
 from typing import Any, Protocol
 
-from orchestra.errors import OrchestraError
+from orchestra.errors import OrchestraError, clip
+from orchestra.launch.evaluate import EvalError, evaluate
 from orchestra.names import anonymous_name
 
 COMMANDS = ("find", "env", "optenv", "dirname", "anon", "arg")
@@ -75,12 +73,12 @@ def _scan(text: str) -> list[str]:
             if state == 0:
                 state = 1
             elif state != 1:
-                raise SubstitutionError(f"'$' cannot appear inside a substitution arg [{text}]")
+                raise SubstitutionError(f"'$' cannot appear inside a substitution arg [{clip(text)}]")
         elif ch == "(":
             if state == 1:
                 state = 2
             elif state != 0:
-                raise SubstitutionError(f"invalid '(' inside a substitution arg [{text}]")
+                raise SubstitutionError(f"invalid '(' inside a substitution arg [{clip(text)}]")
         elif ch == ")":
             if state == 3:
                 found.append("".join(buf))
@@ -160,7 +158,7 @@ def resolve(text: str | None, scope: Scope) -> str | None:
     if not text or "$" not in text:
         return text
     if text.startswith("$(eval ") and text.endswith(")"):
-        return str(evaluate(text[7:-1], scope))
+        return _eval(text[7:-1], scope)
     bodies = collect(text)
     parsed = []
     for body in bodies:
@@ -182,84 +180,32 @@ def resolve(text: str | None, scope: Scope) -> str | None:
     return resolved
 
 
-# ---------------------------------------------------------------------------- $(eval) sandbox
-
-_SAFE_BUILTINS: dict[str, Any] = {
-    name: getattr(builtins, name)
-    for name in ("abs", "all", "any", "bool", "dict", "divmod", "enumerate", "filter", "float",
-                 "int", "len", "list", "map", "max", "min", "pow", "range", "reversed",
-                 "round", "set", "sorted", "str", "sum", "tuple", "zip")
-}
-_FORBIDDEN_ATTRS = {"format", "format_map", "mro"}
-_MAX_EXPONENT = 64
+# ----------------------------------------------------------------------------- $(eval)
 
 
-def _check_expression(expr: str) -> ast.Expression:
-    if "__" in expr:
-        raise SubstitutionError("$(eval ...) may not contain double underscores")
-    try:
-        tree = ast.parse(expr.strip(), mode="eval")
-    except SyntaxError as exc:
-        raise SubstitutionError(f"$(eval {expr}): invalid expression: {exc.msg}") from None
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Attribute) and (node.attr.startswith("_")
-                                                or node.attr in _FORBIDDEN_ATTRS):
-            raise SubstitutionError(f"$(eval ...) may not use the attribute '{node.attr}'")
-        if isinstance(node, (ast.Lambda, ast.NamedExpr)):
-            raise SubstitutionError("$(eval ...) may not define functions or assign")
-        if isinstance(node, ast.BinOp) and isinstance(node.op, ast.Pow):
-            exponent = node.right
-            if not (isinstance(exponent, ast.Constant) and isinstance(exponent.value, (int, float))
-                    and abs(exponent.value) <= _MAX_EXPONENT):
-                raise SubstitutionError("$(eval ...) exponents must be literal numbers up to "
-                                        f"{_MAX_EXPONENT} (no runaway computations)")
-    return tree
+def _convert_arg(text: str) -> Any:
+    # imported lazily: values pulls in the YAML loader, which plain substitution never needs
+    from orchestra.launch.values import convert_value
+    return convert_value(text, "auto")
 
 
-class _Names(dict):
-    """The eval namespace: functions first, then declared args converted like roslaunch."""
-
-    def __init__(self, functions: dict[str, Callable[..., Any]], args: Mapping[str, str]):
-        super().__init__()
-        self._functions = functions
-        self._args = args
-
-    def __missing__(self, key: str) -> Any:
-        if key in self._functions:
-            return self._functions[key]
-        if key in self._args:
-            from orchestra.launch.values import convert_value
-            return convert_value(self._args[key], "auto")
-        raise KeyError(key)
-
-
-def evaluate(expr: str, scope: Scope) -> Any:
-    """Evaluate a ``$(eval)`` expression in the sandbox."""
-    tree = _check_expression(expr)
+def _eval(expr: str, scope: Scope) -> str:
+    """``$(eval EXPR)`` through the safe evaluator, with the launch functions of ``scope``."""
 
     def arg(name: str) -> Any:
         # like a bare name, arg('x') is typed: 'false' is False, '3' is 3
-        if name not in scope.args:
-            raise ArgNotSet(name)
-        from orchestra.launch.values import convert_value
-        return convert_value(scope.args[name], "auto")
+        if not isinstance(name, str) or name not in scope.args:
+            raise ArgNotSet(str(name))
+        return _convert_arg(scope.args[name])
 
     def optenv(name: str, default: str = "") -> str:
         return os.environ.get(name, default)
 
-    functions: dict[str, Callable[..., Any] | bool] = {
+    launch: dict[str, Callable[..., Any]] = {
         "arg": arg, "env": _env, "optenv": optenv, "find": _find_package,
         "anon": anonymous_name, "dirname": lambda: _dirname(scope),
-        "true": True, "false": False, "True": True, "False": False,
     }
-    names = _Names(functions, scope.args)
     try:
-        code = compile(tree, "<eval>", "eval")
-        return eval(code, {"__builtins__": _SAFE_BUILTINS}, names)  # noqa: S307 (sandboxed)
-    except OrchestraError:
-        raise
-    except NameError as exc:
-        raise SubstitutionError(f"$(eval {expr}): {exc} (only args, arg(), env(), optenv(), "
-                                "find(), anon(), dirname() and basic builtins exist)") from None
-    except Exception as exc:  # any runtime error of the user's expression
-        raise SubstitutionError(f"$(eval {expr}): {type(exc).__name__}: {exc}") from None
+        return evaluate(expr, scope.args, launch, _convert_arg)
+    except EvalError as exc:
+        raise SubstitutionError(exc.message) from None

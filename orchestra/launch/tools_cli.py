@@ -73,7 +73,8 @@ def check(ctx: click.Context, words: tuple[str, ...], strict: bool, as_json: boo
     A DIR stands for every launch file under it. Args apply to every file checked.
 
     Each line is FILE:LINE:COLUMN: error|warning: message [code]. Exit status: 0 when no
-    errors were found (warnings allowed unless --strict), 1 otherwise.
+    errors were found (warnings allowed unless --strict), 2 otherwise (as every command
+    exits on a user's mistake).
     """
     from orchestra.launch.check import check_files, check_tree
     from orchestra.names import load_mappings
@@ -99,4 +100,4 @@ def check(ctx: click.Context, words: tuple[str, ...], strict: bool, as_json: boo
                f"{warnings} warning(s)")
     click.echo(summary, err=True)
     if errors or (strict and warnings):
-        ctx.exit(1)
+        ctx.exit(2)

@@ -33,7 +33,7 @@ import os
 import yaml as pyyaml
 from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 
-from orchestra.errors import Location, OrchestraError
+from orchestra.errors import Location, OrchestraError, offset_location
 from orchestra.launch.entity import Entity
 
 # The element key holding the element's own text (inline rosparam YAML).
@@ -93,7 +93,11 @@ def parse_file(path: str) -> Entity:
         text = read_text(path)
     except FileNotFoundError:
         raise LaunchYamlError("launch file not found", Location(path)) from None
-    except (OSError, UnicodeDecodeError) as exc:
+    except UnicodeDecodeError as exc:
+        raise LaunchYamlError(f"not UTF-8: byte 0x{exc.object[exc.start]:02x} cannot be "
+                              f"decoded ({exc.reason})",
+                              offset_location(path, exc.object, exc.start)) from None
+    except OSError as exc:
         raise LaunchYamlError(f"cannot read launch file: {exc}", Location(path)) from None
     return parse_string(text, path)
 
@@ -128,13 +132,29 @@ def _compose(text: str, filename: str) -> Node | None:
         problem = exc.problem or "invalid YAML"
         context = f" ({exc.context})" if exc.context else ""
         raise LaunchYamlError(f"invalid YAML: {problem}{context}", where) from None
+    except pyyaml.reader.ReaderError as exc:
+        # the reader refuses a character (a control character...) and knows only its offset:
+        # a byte offset into the UTF-8 text with libyaml, a character offset without it
+        data = text if _LOADER is pyyaml.SafeLoader else text.encode("utf-8")
+        where = offset_location(filename, data, exc.position)
+        if isinstance(data, bytes):  # report the column in characters, as marks do
+            line_start = data.rfind(b"\n", 0, exc.position) + 1
+            column = len(data[line_start:exc.position].decode("utf-8", "replace")) + 1
+            where = Location(filename, where.line, column)
+        raise LaunchYamlError(f"invalid YAML: character {_char_name(exc.character)} is not "
+                              f"allowed ({exc.reason})", where) from None
     except pyyaml.YAMLError as exc:
-        raise LaunchYamlError(f"invalid YAML: {exc}", Location(filename)) from None
+        raise LaunchYamlError(f"invalid YAML: {exc}", Location(filename, 1, 1)) from None
     documents = [doc for doc in documents if doc is not None]
     if len(documents) > 1:
         raise LaunchYamlError("a YAML launch file holds exactly one document (found a second "
                               "'---')", _location(filename, documents[1]))
     return documents[0] if documents else None
+
+
+def _char_name(character: str | int) -> str:
+    code = character if isinstance(character, int) else ord(character)
+    return f"U+{code:04X}"
 
 
 def _refuse_foreign_tags(root: Node, filename: str) -> None:
