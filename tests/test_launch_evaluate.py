@@ -64,7 +64,7 @@ def test_allowed_grammar_gives_roslaunchs_results():
                           input=json.dumps([ARGS, ALLOWED]), capture_output=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
     theirs = json.loads(proc.stdout)
-    for expr, expected in zip(ALLOWED, theirs):
+    for expr, expected in zip(ALLOWED, theirs, strict=True):
         assert expected != "ERROR", expr
         assert ours(expr) == expected, expr
 

@@ -30,8 +30,9 @@ import ast
 import builtins
 import math
 import re
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any, Callable, Mapping
+from typing import Any
 
 from orchestra.errors import OrchestraError, clip
 
@@ -374,7 +375,7 @@ class _Calls:
 
     def map_(self, function: Any, *iterables: Any) -> list[Any]:
         columns = [self._items(i) for i in iterables]
-        return [self.call(function, *args) for args in zip(*columns)]
+        return [self.call(function, *args) for args in zip(*columns, strict=False)]
 
     def filter_(self, function: Any, value: Any) -> list[Any]:
         items = self._items(value)
@@ -383,7 +384,7 @@ class _Calls:
         return [item for item in items if self.call(function, item)]
 
     def zip_(self, *iterables: Any) -> list[tuple[Any, ...]]:
-        return list(zip(*(self._items(i) for i in iterables)))
+        return list(zip(*(self._items(i) for i in iterables), strict=False))
 
     def enumerate_(self, value: Any, start: int = 0) -> list[tuple[int, Any]]:
         return list(enumerate(self._items(value), start))
@@ -518,7 +519,7 @@ class _Evaluator:
     def _Dict(self, node: ast.Dict) -> dict[Any, Any]:
         if any(k is None for k in node.keys):
             raise _Refused("'**' unpacking is not supported")
-        return {self.run(k): self.run(v) for k, v in zip(node.keys, node.values)
+        return {self.run(k): self.run(v) for k, v in zip(node.keys, node.values, strict=True)
                 if k is not None}
 
     def _JoinedStr(self, node: ast.JoinedStr) -> str:
@@ -563,7 +564,7 @@ class _Evaluator:
 
     def _Compare(self, node: ast.Compare) -> bool:
         left = self.run(node.left)
-        for op, comparator in zip(node.ops, node.comparators):
+        for op, comparator in zip(node.ops, node.comparators, strict=True):
             right = self.run(comparator)
             if not _COMPARE[type(op)](left, right):
                 return False
