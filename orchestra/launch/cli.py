@@ -78,12 +78,8 @@ def _dump_json(plan: Any) -> str:
 
     from orchestra.launch.interpreter import binary_to_json
     doc = plan.to_json()
-    try:
-        from orchestra.supervise.command import exec_table
-    except ImportError:
-        exec_table = None
-    if exec_table is not None:
-        doc["exec"] = exec_table(plan)
+    from orchestra.supervise.command import exec_table
+    doc["exec"] = exec_table(plan)
     return json.dumps(doc, indent=1, default=binary_to_json)
 
 

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import yaml as pyyaml
 from lxml import etree
-from yaml.nodes import MappingNode, ScalarNode, SequenceNode
+from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 
 from orchestra.errors import Location, OrchestraError
 from orchestra.launch import yaml as yaml_frontend
@@ -125,7 +125,8 @@ def _body_node(entity: Entity):
         if not entity.children:
             return _scalar("")  # `- group:` : nothing in it
         return _children_node(entity.children)
-    pairs = [(_scalar(name), _scalar(value)) for name, value in entity.attributes.items()]
+    pairs: list[tuple[Node, Node]] = [
+        (_scalar(name), _scalar(value)) for name, value in entity.attributes.items()]
     if text is not None:
         style = "|" if "\n" in text else None
         pairs.append((_scalar(yaml_frontend.TEXT_KEY), _scalar(text, style)))

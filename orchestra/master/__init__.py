@@ -25,6 +25,7 @@ from orchestra.master.client import (
 from orchestra.master.notify import Notifier
 from orchestra.master.server import ThreadedXMLRPCServer, bind_address
 from orchestra.params.tree import ParamTree
+from orchestra.rpc import DEFAULT_PORT
 
 __all__ = [
     "DEFAULT_MASTER_URI", "MasterHandle", "MasterUnreachable", "bind_address",
@@ -101,7 +102,7 @@ class MasterHandle:
         return f"MasterHandle({self.uri!r})"
 
 
-def start_master(host: str = "127.0.0.1", port: int = 11311,
+def start_master(host: str = "127.0.0.1", port: int = DEFAULT_PORT,
                  advertise: str | None = None) -> MasterHandle:
     """Start a threaded master serving on ``host:port`` (0 = a free port); return at once.
 

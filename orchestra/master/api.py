@@ -146,7 +146,7 @@ class MasterAPI:
         """Validate and run one call; unknown methods are XML-RPC faults, as in rosmaster."""
         fn = getattr(self, method, None) if not method.startswith("_") else None
         spec: _Spec | None = getattr(fn, "_api_spec", None)
-        if spec is None:
+        if fn is None or spec is None:
             raise Exception(f'method "{method}" is not supported')
         if len(params) == 0:
             return -1, "missing required caller_id parameter", spec.error_value

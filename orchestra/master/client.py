@@ -5,35 +5,33 @@ embedded one, or ROS's own rosmaster.
 """
 from __future__ import annotations
 
-import os
 import urllib.parse
 import xmlrpc.client
 from collections.abc import Mapping, Sequence
-from http.client import HTTPException
 from typing import Any
 
 from orchestra.errors import OrchestraError
-from orchestra.master.notify import TimeoutTransport
 from orchestra.params.tree import check_value
+from orchestra.rpc import (
+    DEFAULT_MASTER_URI,
+    DEFAULT_PORT,
+    TRANSPORT_ERRORS,
+    master_uri_from_env,
+    multicall_results,
+    proxy,
+    unpack_reply,
+)
 
-DEFAULT_MASTER_URI = "http://localhost:11311/"
-DEFAULT_PORT = 11311
-
-# what goes wrong on the wire when nobody (or something odd) answers
-TRANSPORT_ERRORS = (OSError, HTTPException, xmlrpc.client.ProtocolError,
-                    xmlrpc.client.ResponseError)
+__all__ = [
+    "DEFAULT_MASTER_URI", "DEFAULT_PORT", "TRANSPORT_ERRORS", "MasterUnreachable",
+    "master_is_up", "master_uri_from_env", "port_from_uri", "proxy", "upload_params",
+]
 
 
 class MasterUnreachable(OrchestraError):
     """No master answers at the given URI."""
 
     exit_code = 1
-
-
-def master_uri_from_env(environ: Mapping[str, str] | None = None) -> str:
-    """ROS_MASTER_URI, or roscore's default ``http://localhost:11311/``."""
-    env = os.environ if environ is None else environ
-    return env.get("ROS_MASTER_URI") or DEFAULT_MASTER_URI
 
 
 def port_from_uri(uri: str) -> int:
@@ -45,17 +43,13 @@ def port_from_uri(uri: str) -> int:
     return port if port is not None else DEFAULT_PORT
 
 
-def proxy(uri: str, timeout: float | None = None) -> xmlrpc.client.ServerProxy:
-    """An XML-RPC proxy for ``uri``; ``timeout`` bounds each call (None = wait forever)."""
-    transport = TimeoutTransport(timeout) if timeout is not None else None
-    return xmlrpc.client.ServerProxy(uri, transport=transport)
-
-
 def master_is_up(uri: str, timeout: float = 1.0) -> bool:
     """True when something at ``uri`` answers ``getPid`` like a ROS master."""
     try:
-        code, _, _ = proxy(uri, timeout).getPid("/orchestra")
-    except (TimeoutError, *TRANSPORT_ERRORS, xmlrpc.client.Fault, ValueError, TypeError):
+        code, _, _ = unpack_reply(proxy(uri, timeout).getPid("/orchestra"))
+    except TRANSPORT_ERRORS:
+        return False
+    except (xmlrpc.client.Fault, ValueError, TypeError):  # something else answers there
         return False
     return code == 1
 
@@ -78,7 +72,7 @@ def upload_params(master_uri: str, params: Mapping[str, Any], clear_params: Sequ
     for name in names:
         multi.setParam(caller_id, name, params[name])
     try:
-        results = list(multi())
+        results = multicall_results(multi)
     except xmlrpc.client.Fault as exc:
         raise OrchestraError(f"master at {master_uri} refused the parameters: "
                              f"{exc.faultString}") from None

@@ -10,26 +10,14 @@ from __future__ import annotations
 
 import logging
 import threading
-import xmlrpc.client
 from collections import deque
 from typing import Any
+
+from orchestra.rpc import proxy as rpc_proxy
 
 log = logging.getLogger(__name__)
 
 MASTER_CALLER_ID = "/master"
-
-
-class TimeoutTransport(xmlrpc.client.Transport):
-    """An XML-RPC transport whose connections give up after ``timeout`` seconds."""
-
-    def __init__(self, timeout: float):
-        super().__init__()
-        self.timeout = timeout
-
-    def make_connection(self, host):  # type: ignore[override]
-        conn = super().make_connection(host)
-        conn.timeout = self.timeout
-        return conn
 
 
 class Notifier:
@@ -56,7 +44,7 @@ class Notifier:
                          name=f"notify {api}").start()
 
     def _drain(self, api: str) -> None:
-        proxy = xmlrpc.client.ServerProxy(api, transport=TimeoutTransport(self.timeout))
+        proxy = rpc_proxy(api, self.timeout)
         try:
             while True:
                 with self._lock:

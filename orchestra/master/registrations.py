@@ -106,7 +106,7 @@ class Registrations:
                     result = (1, f"Unregistered [{caller_id}] as provider of [{key}]", 1)
             else:
                 providers = self.topics[kind].get(key, [])
-                if (caller_id, caller_api) in providers:
+                if caller_api is not None and (caller_id, caller_api) in providers:
                     providers.remove((caller_id, caller_api))
                     if not providers:
                         del self.topics[kind][key]

@@ -7,41 +7,29 @@ port, alive after the master is gone.
 """
 from __future__ import annotations
 
-import logging
 import os
 import socket
-import socketserver
 import threading
-from xmlrpc.server import SimpleXMLRPCRequestHandler, SimpleXMLRPCServer
 
-log = logging.getLogger(__name__)
+from orchestra.rpc import AnyPathHandler, ThreadedServer
 
 LOCALHOST_NAMES = ("localhost", "127.0.0.1", "::1")
 
 
-class _Handler(SimpleXMLRPCRequestHandler):
+class _Handler(AnyPathHandler):
     protocol_version = "HTTP/1.1"
-    rpc_paths = ()  # rospy and roscpp post to "/", others to "/RPC2": accept any path
     # an idle keep-alive connection is closed after this long (seconds)
     timeout = 60
 
-    def log_message(self, format, *args):  # route http.server chatter to logging
-        log.debug("%s " + format, self.address_string(), *args)
 
+class ThreadedXMLRPCServer(ThreadedServer):
+    """The shared threaded server, with HTTP/1.1 keep-alive and connections tracked."""
 
-class ThreadedXMLRPCServer(socketserver.ThreadingMixIn, SimpleXMLRPCServer):
-    """SimpleXMLRPCServer answering each connection in its own daemon thread."""
-
-    daemon_threads = True
     block_on_close = False
-    allow_reuse_address = True
     request_queue_size = 128
 
     def __init__(self, addr: tuple[str, int]):
-        family = socket.AF_INET6 if ":" in addr[0] else socket.AF_INET
-        self.address_family = family
-        super().__init__(addr, requestHandler=_Handler, logRequests=False, allow_none=False,
-                         bind_and_activate=True)
+        super().__init__(addr, handler=_Handler)
         self._connections: set[socket.socket] = set()
         self._conn_lock = threading.Condition()
 

@@ -11,6 +11,7 @@ import math
 import queue
 import re
 import time
+from typing import TYPE_CHECKING
 
 import click
 import yaml
@@ -19,6 +20,9 @@ from orchestra.errors import OrchestraError
 from orchestra.node import introspect
 from orchestra.node.exceptions import ROSException
 from orchestra.node.loggers import LEVEL_NAMES
+
+if TYPE_CHECKING:
+    from orchestra.node.msg import Message
 
 CLI_NODE = "orchestra_cli"
 
@@ -521,7 +525,7 @@ class _Decoder:
     missing: echo works for any type, even without its .msg file."""
 
     def __init__(self):
-        self._classes: dict[tuple[str, str], type] = {}
+        self._classes: dict[tuple[str, str], type[Message]] = {}
 
     def __call__(self, raw):
         from orchestra.node.msg import MessageNotFound, get_message_class, message_class_from_definition

@@ -82,7 +82,7 @@ def to_svg(graph: nx.DiGraph) -> str:
         columns.setdefault(col_of[v], []).append(v)
     width_of = {v: max(60.0, len(graph.nodes[v]["label"]) * CHAR_W + 24) for v in graph.nodes}
     col_x: dict[int, float] = {}
-    x = MARGIN
+    x: float = MARGIN
     for col in sorted(columns):
         col_x[col] = x
         x += max(width_of[v] for v in columns[col]) + COL_GAP

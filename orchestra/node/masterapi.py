@@ -7,11 +7,11 @@ extra connect costs tens of microseconds.
 """
 from __future__ import annotations
 
-import http.client
 import xmlrpc.client
 from typing import Any
 
 from orchestra.node.exceptions import ROSException
+from orchestra.rpc import TRANSPORT_ERRORS, proxy
 
 DEFAULT_TIMEOUT = 10.0
 
@@ -24,26 +24,11 @@ class MasterError(ROSException):
         self.code = code
 
 
-class _TimeoutTransport(xmlrpc.client.Transport):
-    def __init__(self, timeout: float):
-        super().__init__()
-        self._timeout = timeout
-
-    def make_connection(self, host):
-        conn = super().make_connection(host)
-        conn.timeout = self._timeout
-        return conn
-
-
-def proxy(uri: str, timeout: float = DEFAULT_TIMEOUT) -> xmlrpc.client.ServerProxy:
-    return xmlrpc.client.ServerProxy(uri, transport=_TimeoutTransport(timeout))
-
-
 def raw_call(uri: str, method: str, *args: Any, timeout: float = DEFAULT_TIMEOUT) -> list:
     """``[code, msg, value]`` from ``method`` at ``uri``; unreachable -> MasterError."""
     try:
         result = getattr(proxy(uri, timeout), method)(*args)
-    except (TimeoutError, OSError, http.client.HTTPException, xmlrpc.client.ProtocolError) as exc:
+    except TRANSPORT_ERRORS as exc:
         raise MasterError(f"cannot reach {uri} ({method}): {exc}") from exc
     except xmlrpc.client.Fault as exc:
         raise MasterError(f"{uri} {method} failed: {exc.faultString}") from exc

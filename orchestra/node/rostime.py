@@ -246,6 +246,7 @@ def sleep(duration: float | Duration) -> None:
     span = _to_ns(duration)
     if _sim_ns is not None:
         start = _first_clock()
+        assert start is not None  # None only when a cancel event is given
         _wait_sim(start + span, start)
         return
     if span <= 0:

@@ -34,9 +34,9 @@ from orchestra.node.exceptions import (
 )
 from orchestra.node.masterapi import Master, MasterError
 from orchestra.node.topics import TopicManager
+from orchestra.rpc import master_uri_from_env
 
 log = logging.getLogger(__name__)
-DEFAULT_MASTER_URI = "http://localhost:11311/"
 _UNSET = object()
 
 
@@ -347,8 +347,7 @@ def init_node(name: str, argv: list[str] | None = None, anonymous: bool = False,
             if _runtime.name == full_name:
                 return
             raise ROSInitException(f"init_node() was already called as {_runtime.name}")
-        master_uri = _parse_master_uri(special.get("__master")
-                                       or os.environ.get("ROS_MASTER_URI") or DEFAULT_MASTER_URI)
+        master_uri = _parse_master_uri(special.get("__master") or master_uri_from_env())
         remaps = names.resolve_remaps(parsed.remaps, namespace, full_name)
         host = _advertise_host(special, master_uri)
         runtime = NodeRuntime(full_name, namespace, master_uri, remaps, host, argv)

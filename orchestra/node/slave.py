@@ -8,27 +8,15 @@ from __future__ import annotations
 
 import logging
 import os
-import socketserver
 import threading
 from typing import TYPE_CHECKING, Any
-from xmlrpc.server import SimpleXMLRPCRequestHandler, SimpleXMLRPCServer
+
+from orchestra.rpc import ThreadedServer
 
 if TYPE_CHECKING:
     from orchestra.node.runtime import NodeRuntime
 
 log = logging.getLogger(__name__)
-
-
-class _QuietHandler(SimpleXMLRPCRequestHandler):
-    rpc_paths = ()  # any path: some clients post to "/RPC2", rospy to "/"
-
-    def log_message(self, format, *args):  # noqa: A002 - signature fixed by http.server
-        log.debug("slave api: " + format, *args)
-
-
-class _Server(socketserver.ThreadingMixIn, SimpleXMLRPCServer):
-    daemon_threads = True
-    allow_reuse_address = True
 
 
 class SlaveAPI:
@@ -83,8 +71,7 @@ class SlaveServer:
     """An XML-RPC server on an ephemeral port, serving ``SlaveAPI`` from a daemon thread."""
 
     def __init__(self, runtime: NodeRuntime, bind_host: str, advertise_host: str, port: int = 0):
-        self._server = _Server((bind_host, port), _QuietHandler,
-                               logRequests=False, allow_none=False)
+        self._server = ThreadedServer((bind_host, port))
         self._server.register_instance(SlaveAPI(runtime))
         self.port = self._server.server_address[1]
         self.uri = f"http://{advertise_host}:{self.port}/"

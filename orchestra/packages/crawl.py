@@ -155,7 +155,7 @@ def crawl(root: str, previous: dict[str, Record] | None = None) -> CrawlResult:
             continue
         visited.add(identity)
         record = previous.get(directory)
-        if not _fresh(directory, record, st.st_mtime_ns):
+        if record is None or not _fresh(directory, record, st.st_mtime_ns):
             record = _scan(directory, st.st_mtime_ns, racy_after)
             result.listed += 1
             result.changed = True

@@ -15,6 +15,7 @@ import os
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from typing import Literal, overload
 
 from lxml import etree
 
@@ -242,7 +243,13 @@ def _person(element) -> Person:
     return Person(" ".join(_text(element).split()), email.strip() if email else None)
 
 
-def _single(root, tag: str, path: str, required: bool) -> object | None:
+@overload
+def _single(root, tag: str, path: str, required: Literal[True]) -> etree._Element: ...
+@overload
+def _single(root, tag: str, path: str, required: bool) -> etree._Element | None: ...
+
+
+def _single(root, tag: str, path: str, required: bool) -> etree._Element | None:
     found = root.findall(tag)
     if len(found) > 1:
         raise InvalidManifest(f"<{tag}> may appear only once", Location(path, found[1].sourceline))

@@ -15,9 +15,10 @@ from typing import Any
 import click
 
 from orchestra.errors import Location, OrchestraError
-from orchestra.master.client import TRANSPORT_ERRORS, MasterUnreachable, master_uri_from_env, proxy
+from orchestra.master.client import MasterUnreachable
 from orchestra.params.dump import dump_yaml, format_get
 from orchestra.params.tree import SEP, ParamValueError, canonical, check_value, ns_join, resolve
+from orchestra.rpc import TRANSPORT_ERRORS, master_uri_from_env, multicall_results, proxy
 
 NS_KEY = "_ns"  # a YAML document's own namespace, as rosparam reads it
 
@@ -68,7 +69,7 @@ class _Master:
         for name, value in items:
             multi.setParam(self.caller_id, name, value)
         try:
-            results = list(multi())
+            results = multicall_results(multi)
         except xmlrpc.client.Fault as exc:
             raise ParamCommandError(f"master at {self.uri} failed: {exc.faultString}") from None
         except TRANSPORT_ERRORS as exc:

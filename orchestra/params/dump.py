@@ -23,7 +23,7 @@ def _represent_binary(dumper: yaml.SafeDumper, data: xmlrpc.client.Binary) -> ya
     return dumper.represent_scalar("tag:yaml.org,2002:binary", text, style="|")
 
 
-def _represent_bytes(dumper: yaml.SafeDumper, data: bytes) -> yaml.Node:
+def _represent_bytes(dumper: yaml.SafeDumper, data: bytes | bytearray) -> yaml.Node:
     return _represent_binary(dumper, xmlrpc.client.Binary(bytes(data)))
 
 

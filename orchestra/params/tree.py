@@ -241,7 +241,7 @@ class ParamTree:
             raise KeyError("cannot delete root of parameter tree")
         with self._lock:
             parts = _parts(key)
-            d = self._root
+            d: object = self._root
             for part in parts[:-1]:
                 d = d.get(part) if isinstance(d, dict) else None
                 if not isinstance(d, dict):
@@ -319,10 +319,10 @@ class ParamTree:
             elif inner is not None and sub.startswith(param_key) and sub not in inner_set:
                 updates.append(ParamUpdate(tuple(nodes), sub, {}))
         for sub in inner or ():
-            nodes = self._subscribers.get(sub)
-            if nodes:
+            listeners = self._subscribers.get(sub)
+            if listeners:
                 sub_value = value
                 for part in _parts(sub[len(param_key):]):
                     sub_value = sub_value[part]
-                updates.append(ParamUpdate(tuple(nodes), sub, _copy_dicts(sub_value)))
+                updates.append(ParamUpdate(tuple(listeners), sub, _copy_dicts(sub_value)))
         return updates

@@ -12,6 +12,7 @@ import ast
 import math
 import operator
 import re
+from collections.abc import Callable
 from typing import Any
 
 import yaml
@@ -24,10 +25,11 @@ class RosparamYamlError(OrchestraError):
     """A YAML document rosparam could not load."""
 
 
-_BINOPS = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul,
-           ast.Div: operator.truediv, ast.Pow: operator.pow, ast.Mod: operator.mod,
-           ast.FloorDiv: operator.floordiv}
-_UNARY = {ast.USub: operator.neg, ast.UAdd: operator.pos}
+_BINOPS: dict[type[ast.operator], Callable[[float, float], float]] = {
+    ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul,
+    ast.Div: operator.truediv, ast.Pow: operator.pow, ast.Mod: operator.mod,
+    ast.FloorDiv: operator.floordiv}
+_UNARY: dict[type[ast.unaryop], Callable[[float], float]] = {ast.USub: operator.neg, ast.UAdd: operator.pos}
 
 
 def _arith(node: ast.AST) -> float:
@@ -57,7 +59,7 @@ def _unwrap(value: str, prefix: str) -> str:
     return value
 
 
-def _construct_radians(loader: yaml.SafeLoader, node: yaml.Node) -> float:
+def _construct_radians(loader: yaml.SafeLoader, node: yaml.ScalarNode) -> float:
     text = _unwrap(loader.construct_scalar(node), "rad")
     try:
         return angle_expression(text)
@@ -66,7 +68,7 @@ def _construct_radians(loader: yaml.SafeLoader, node: yaml.Node) -> float:
             None, None, f"invalid radian expression {text!r}: {exc}", node.start_mark) from None
 
 
-def _construct_degrees(loader: yaml.SafeLoader, node: yaml.Node) -> float:
+def _construct_degrees(loader: yaml.SafeLoader, node: yaml.ScalarNode) -> float:
     text = _unwrap(loader.construct_scalar(node), "deg")
     try:
         return float(text) * math.pi / 180.0

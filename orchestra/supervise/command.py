@@ -23,6 +23,7 @@ from typing import Any
 
 from orchestra.errors import Location, OrchestraError
 from orchestra.launch.plan import LaunchPlan, Node
+from orchestra.packages import find_executable
 
 
 class ExecutableNotFound(OrchestraError):
@@ -37,45 +38,12 @@ def _location(node: Node) -> Location | None:
     return Location(node.filename, node.line) if node.filename else None
 
 
-def _is_executable_file(path: str) -> bool:
-    return os.path.isfile(path) and os.access(path, os.X_OK)
-
-
-def _lookup_executable(package: str, executable: str) -> str | None:
-    """roslib's find_node: catkin libexec (``<prefix>/lib/<pkg>``) first, then the package tree.
-
-    Used only when the package index does not offer ``find_executable`` (yet).
-    """
-    from orchestra.packages import find_package
-
-    for prefix in os.environ.get("CMAKE_PREFIX_PATH", "").split(os.pathsep):
-        if prefix:
-            candidate = os.path.join(prefix, "lib", package, executable)
-            if _is_executable_file(candidate):
-                return candidate
-    root = find_package(package)
-    for directory, dirs, files in os.walk(root, followlinks=True):
-        dirs[:] = sorted(d for d in dirs if not d.startswith("."))
-        if executable in files:
-            candidate = os.path.join(directory, executable)
-            if _is_executable_file(candidate):
-                return candidate
-    return None
-
-
 def find_node_executable(node: Node) -> str:
     """The absolute path of the node's executable, or ExecutableNotFound naming file:line."""
     if not node.type:
         raise ExecutableNotFound(f"node '{node.name}' has no type", _location(node))
     try:
-        from orchestra.packages import find_executable  # type: ignore[attr-defined]
-    except ImportError:
-        find_executable = None
-    try:
-        if find_executable is not None:
-            path = find_executable(node.package, node.type)
-        else:
-            path = _lookup_executable(node.package, node.type)
+        path = find_executable(node.package, node.type)
     except OrchestraError as exc:
         raise ExecutableNotFound(
             f"node '{node.full_name}': {exc.message}", _location(node)) from None

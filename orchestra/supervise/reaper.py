@@ -42,6 +42,7 @@ logger = logging.getLogger(__name__)
 PR_SET_PDEATHSIG = 1
 MARK_VARIABLE = "ORCHESTRA_RUN_MARK"
 
+_prctl: Callable[..., int] | None
 try:
     _libc = ctypes.CDLL(None, use_errno=True)
     _prctl = _libc.prctl
@@ -77,6 +78,7 @@ def setpriv_prefix() -> tuple[str, ...] | None:
 
 def check_executable(program: str, env: Mapping[str, str], cwd: str) -> None:
     """Raise the OSError exec would raise for ``program`` (not found, not executable, no #!)."""
+    path: str | None
     if os.sep in program:
         path = program if os.path.isabs(program) else os.path.join(cwd, program)
     else:

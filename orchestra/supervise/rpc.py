@@ -16,8 +16,8 @@ import re
 import socket
 from collections.abc import Callable
 from typing import Any
-from xmlrpc.server import SimpleXMLRPCServer
 
+from orchestra.rpc import PolledServer
 from orchestra.supervise.loop import EventLoop
 from orchestra.supervise.process import ManagedProcess, State
 
@@ -43,20 +43,12 @@ def _xmlrpc_safe(doc: dict[str, Any]) -> dict[str, Any]:
             and abs(v) > 2**31 - 1 else v for k, v in doc.items()}
 
 
-class _Server(SimpleXMLRPCServer):
-    def get_request(self):  # a slow or silent client must not stall the supervisor
-        conn, addr = self.socket.accept()
-        conn.settimeout(2.0)
-        return conn, addr
-
-
 class LaunchRPCServer:
     def __init__(self, loop: EventLoop, procs: list[ManagedProcess],
                  make_snapshot: Callable[[], dict[str, Any]], loopback: bool = True):
         bind = "127.0.0.1" if loopback else "0.0.0.0"
-        self._server = _Server((bind, 0), logRequests=False, allow_none=True)
-        self._server.socket.setblocking(False)
-        self.port = self._server.server_address[1]
+        self._server = PolledServer((bind, 0), allow_none=True)
+        self.port = self._server.port
         self.host = advertised_host(loopback)
         self.uri = f"http://{self.host}:{self.port}/"
         self._procs = procs
@@ -69,7 +61,7 @@ class LaunchRPCServer:
 
     def _handle(self) -> None:
         try:
-            self._server._handle_request_noblock()
+            self._server.handle_ready()
         except OSError as exc:  # pragma: no cover - a client that went away
             logger.debug("launch rpc: %s", exc)
 

@@ -11,12 +11,14 @@ import json
 import os
 import socket
 import stat
+import xmlrpc.client
 from collections.abc import Callable
 from typing import Any
 
 import psutil
 
-from orchestra.supervise.loop import EventLoop
+from orchestra.rpc import proxy, unpack_reply
+from orchestra.supervise.loop import EventLoop, Timer
 from orchestra.supervise.process import ManagedProcess, State
 
 SNAPSHOT_VERSION = 1
@@ -98,10 +100,11 @@ def _duration(seconds: float) -> str:
 def _size(rss: int | None) -> str:
     if rss is None:
         return "-"
+    size: float = rss
     for unit in ("B", "K", "M", "G"):
-        if rss < 1024 or unit == "G":
-            return f"{rss:.0f}{unit}" if unit == "B" else f"{rss:.1f}{unit}"
-        rss /= 1024
+        if size < 1024 or unit == "G":
+            return f"{size:.0f}{unit}" if unit == "B" else f"{size:.1f}{unit}"
+        size /= 1024
     return "-"
 
 
@@ -316,12 +319,9 @@ def launches_on_master(master_uri: str, timeout: float = 3.0) -> list[dict[str, 
 
     Entries of real roslaunch processes (no ``orchestra_status``) and dead ones are skipped.
     """
-    import xmlrpc.client
-
-    from orchestra.master.client import proxy
-
     try:
-        code, _, uris = proxy(master_uri, timeout).getParam("/orchestra_status", "/roslaunch/uris")
+        code, _, uris = unpack_reply(
+            proxy(master_uri, timeout).getParam("/orchestra_status", "/roslaunch/uris"))
     except (OSError, xmlrpc.client.Error):
         raise OSError(f"no master answers at {master_uri}") from None
     if code != 1 or not isinstance(uris, dict):
@@ -329,7 +329,8 @@ def launches_on_master(master_uri: str, timeout: float = 3.0) -> list[dict[str, 
     found = []
     for key in sorted(uris):
         try:
-            code, _, doc = proxy(str(uris[key]), timeout).orchestra_status("/orchestra_status")
+            code, _, doc = unpack_reply(
+                proxy(str(uris[key]), timeout).orchestra_status("/orchestra_status"))
             if code == 1:
                 found.append(json.loads(doc))
         except (OSError, xmlrpc.client.Error, ValueError):
@@ -346,8 +347,8 @@ class LiveView:
         self._screen = screen
         self._make = make_snapshot
         self._interval = interval
-        self._timer = None
-        self._pending = None
+        self._timer: Timer | None = None
+        self._pending: Timer | None = None
         self._closed = False
 
     def start(self) -> None:

@@ -13,6 +13,7 @@ exit) or failed to start, or when any node ended FAILED (the message says which)
 from __future__ import annotations
 
 import errno
+import functools
 import logging
 import os
 import signal
@@ -166,7 +167,7 @@ class Supervisor:
             proc.transition(State.STOPPING, reason)
             signal_group(pid, signal.SIGINT, child.extra)
             self._set_timer(proc, proc.spec.sigint_timeout,
-                            lambda p=proc: self._escalate(p, signal.SIGTERM))
+                            functools.partial(self._escalate, proc, signal.SIGTERM))
         self._changed()
 
     def kill_all(self) -> None:
@@ -300,7 +301,7 @@ class Supervisor:
             os.makedirs(spec.cwd, exist_ok=True)
             if self.pdeathsig == "setpriv":
                 check_executable(argv[0], spec.env, spec.cwd)
-                argv = [*setpriv_prefix(), *argv]
+                argv = [*(setpriv_prefix() or ()), *argv]  # checked at __init__
             popen = subprocess.Popen(
                 argv, cwd=spec.cwd, env={**spec.env, MARK_VARIABLE: self.mark},
                 stdin=None,  # inherited, as roslaunch
@@ -321,10 +322,11 @@ class Supervisor:
                              name=f"wait {spec.name}").start()
         output = self.outputs[spec.name]
         for stream, pipe in (("out", popen.stdout), ("err", popen.stderr)):
+            assert pipe is not None  # both are subprocess.PIPE
             fd = pipe.fileno()
             os.set_blocking(fd, False)
             self._open_pipes += 1
-            self.loop.add_reader(fd, lambda fd=fd, s=stream, p=pipe: self._on_output(fd, s, p, output))
+            self.loop.add_reader(fd, functools.partial(self._on_output, fd, stream, pipe, output))
         proc.pid = popen.pid
         proc.started_at = time.monotonic()
         proc.exit_code = None
