@@ -197,15 +197,17 @@ def test_missing_executable_fails_before_anything_starts(no_master_env):
     assert not master_is_up(f"http://localhost:{run_env['port']}/", timeout=0.5)
 
 
-def test_remote_machine_node_is_an_error_unless_local_leaves_it_out(run_env, capsys):
+def test_remote_machine_with_password_is_refused_unless_local_leaves_it_out(run_env, capsys):
+    # (refused before any connection: no traffic to the documentation address 192.0.2.7)
     plan = LaunchPlan(nodes=(Node("demo", "probe", "far", machine_name="robot",
                                   filename="r.launch", line=3),
                              Node("demo", "probe", "near", machine_name="here")),
-                      machines={"robot": Machine("robot", address="192.0.2.7"),
+                      machines={"robot": Machine("robot", address="192.0.2.7", password="pw"),
                                 "here": Machine("here", address="localhost")})
     with pytest.raises(OrchestraError) as info:
         run_plan(plan, OPTS)
-    assert "r.launch:3: " in str(info.value) and "--local" in str(info.value)
+    assert "r.launch:3: " in str(info.value) and "password" in str(info.value)
+    assert not (run_env["out"] / "near.json").exists()
     assert run_plan(plan, dict(OPTS, local=True)) == 0
     assert (run_env["out"] / "near.json").exists()
     assert not (run_env["out"] / "far.json").exists()

@@ -113,6 +113,20 @@ def node_cwd(node: Node, executable: str, environ: Mapping[str, str] | None = No
     return ros_home(environ)
 
 
+def path_with_interpreter(path: str, executable: str) -> str:
+    """PATH with the directory of orchestra's own interpreter first, unless already on it.
+
+    Python nodes start with ``#!/usr/bin/env python3``; when orchestra runs from a virtualenv
+    that was not activated, that would find a Python without orchestra (and the node runtime)
+    installed. roslaunch has no such problem because ROS is installed system-wide.
+    """
+    directory = os.path.dirname(os.path.abspath(executable))
+    entries = [entry for entry in path.split(os.pathsep) if entry]
+    if directory in entries:
+        return path
+    return os.pathsep.join([directory, *entries])
+
+
 def exec_table(plan: LaunchPlan, include_tests: bool = False) -> dict[str, dict[str, Any]]:
     """``{"/full/name": {"argv": [...], "env": {...}}}`` for ``--dump-plan`` (compat contract).
 

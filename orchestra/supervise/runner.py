@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import logging
 import os
-import socket
 import sys
 import time
 import urllib.parse
@@ -25,7 +24,8 @@ import click
 
 from orchestra.errors import Location, OrchestraError
 from orchestra.launch.plan import LaunchPlan, Node
-from orchestra.supervise.command import find_node_executable, node_argv, node_cwd, node_env
+from orchestra.supervise.command import (find_node_executable, node_argv, node_cwd, node_env,
+                                         path_with_interpreter, ros_home)
 from orchestra.supervise.output import Screen, prepare_run_log_dir
 from orchestra.supervise.process import OutputMode, ProcessSpec, RestartPolicy
 
@@ -110,46 +110,26 @@ def _location(node: Node) -> Location | None:
     return Location(node.filename, node.line) if node.filename else None
 
 
-def is_local_address(address: str) -> bool:
-    """True when ``address`` names this machine (roslaunch runs such machines' nodes locally)."""
-    if not address or address in LOCAL_NAMES or address.startswith("127."):
-        return True
-    if address in (socket.gethostname(), socket.getfqdn()):
-        return True
-    try:
-        resolved = {info[4][0] for info in socket.getaddrinfo(address, None)}
-    except OSError:
-        return False
-    try:
-        import psutil
+def split_remote(plan: LaunchPlan, nodes: list[Node]) -> tuple[list[Node], list[Node]]:
+    """(nodes to run here, nodes of remote machines), split as roslaunch splits them."""
+    from orchestra.remote.locality import UnresolvableAddress, is_local_machine
 
-        mine = {a.address for addrs in psutil.net_if_addrs().values() for a in addrs}
-    except Exception:  # noqa: BLE001 - best effort only
-        mine = set()
-    return bool(resolved & (mine | {"127.0.0.1", "::1"}))
-
-
-def split_remote(plan: LaunchPlan, nodes: list[Node], local: bool) -> tuple[list[Node], list[Node]]:
-    """(nodes to run here, remote nodes skipped by ``--local``).
-
-    roslaunch starts nodes of a remote ``<machine>`` over ssh; orchestra does not, so such a
-    node is a user error unless ``--local`` (roslaunch's "do not launch remote nodes") says to
-    leave them out.
-    """
     here: list[Node] = []
     remote: list[Node] = []
+    verdicts: dict[str, bool] = {}
     for node in nodes:
         machine = plan.machines.get(node.machine_name or "")
-        if machine is not None and node.machine_name and not is_local_address(machine.address):
-            if not local:
-                raise OrchestraError(
-                    f"node '{node.full_name}' runs on machine '{machine.name}' "
-                    f"({machine.address}); orchestra does not start nodes over ssh: run "
-                    "orchestra on that machine, or pass --local to leave remote nodes out",
-                    _location(node))
-            remote.append(node)
-        else:
+        if machine is None or not node.machine_name:
             here.append(node)
+            continue
+        if machine.name not in verdicts:
+            try:
+                verdicts[machine.name] = is_local_machine(machine.address, machine.user)
+            except UnresolvableAddress:
+                raise OrchestraError(f"cannot resolve host address for machine "
+                                     f"'{machine.name}' ({machine.address})",
+                                     _location(node)) from None
+        (here if verdicts[machine.name] else remote).append(node)
     return here, remote
 
 
@@ -194,20 +174,6 @@ def output_mode(node: Node, options: RunOptions) -> OutputMode:
     if node.output == "both":
         return OutputMode.BOTH
     return OutputMode.LOG
-
-
-def path_with_interpreter(path: str, executable: str) -> str:
-    """PATH with the directory of orchestra's own interpreter first, unless already on it.
-
-    Python nodes start with ``#!/usr/bin/env python3``; when orchestra runs from a virtualenv
-    that was not activated, that would find a Python without orchestra (and the node runtime)
-    installed. roslaunch has no such problem because ROS is installed system-wide.
-    """
-    directory = os.path.dirname(os.path.abspath(executable))
-    entries = [entry for entry in path.split(os.pathsep) if entry]
-    if directory in entries:
-        return path
-    return os.pathsep.join([directory, *entries])
 
 
 def build_specs(nodes: list[Node], executables: Mapping[str, str], master_uri: str,
@@ -269,8 +235,12 @@ def _existing_run_id(uri: str) -> str | None:
     return value if code == 1 and isinstance(value, str) else None
 
 
-def connect_master(options: RunOptions, echo) -> MasterConnection:
-    """Use the master at ROS_MASTER_URI if it answers, wait for it (--wait), or embed one."""
+def connect_master(options: RunOptions, echo, public: bool = False) -> MasterConnection:
+    """Use the master at ROS_MASTER_URI if it answers, wait for it (--wait), or embed one.
+
+    ``public``: other machines must reach an embedded master (the plan has remote nodes),
+    so it listens on every interface even when ROS_MASTER_URI names localhost.
+    """
     from orchestra.master import master_is_up, master_uri_from_env, port_from_uri, start_master
 
     uri = master_uri_from_env()
@@ -287,7 +257,8 @@ def connect_master(options: RunOptions, echo) -> MasterConnection:
         run_id = _existing_run_id(uri) or options.run_id or str(uuid.uuid1())
         return MasterConnection(uri, None, run_id)
     host = urllib.parse.urlsplit(uri).hostname or "localhost"
-    bind = "127.0.0.1" if host in LOCAL_NAMES or host.startswith("127.") else "0.0.0.0"
+    loopback = host in LOCAL_NAMES or host.startswith("127.")
+    bind = "127.0.0.1" if loopback and not public else "0.0.0.0"
     handle = start_master(bind, port_from_uri(uri), advertise=host)
     echo(f"started embedded master at {handle.uri}")
     return MasterConnection(handle.uri, handle, options.run_id or str(uuid.uuid1()))
@@ -364,6 +335,26 @@ def run_param_actions(plan: LaunchPlan, uri: str, echo) -> None:
         echo(f"rosparam dump {action.param} -> {action.file}")
 
 
+def open_remote(plan: LaunchPlan, remote: list[Node], watchdog: Any) -> Any:
+    """Connect and check every remote machine of the run (orchestra/remote/session.py)."""
+    from orchestra.remote.session import RemoteSession
+
+    session = RemoteSession(dict(plan.machines), remote, mark=watchdog.mark,
+                            watch=watchdog.watch)
+    session.open()
+    return session
+
+
+def remote_specs(session: Any, remote: list[Node], master: MasterConnection, run_dir: str,
+                 options: RunOptions) -> list[ProcessSpec]:
+    """Remote nodes' specs: their run settings as local nodes', their command an ssh session."""
+    specs = build_specs(remote, {n.full_name: n.type for n in remote}, master.uri, run_dir,
+                        options)
+    return [replace(spec, cwd=ros_home(), argv=tuple(session.node_argv(
+        node, master.uri, master.run_id, spec.log_name or node.name, spec.sigint_timeout,
+        spec.sigterm_timeout))) for node, spec in zip(remote, specs)]
+
+
 def _is_loopback_uri(uri: str) -> bool:
     host = urllib.parse.urlsplit(uri).hostname or "localhost"
     return host in LOCAL_NAMES or host.startswith("127.")
@@ -406,7 +397,7 @@ def run_plan(plan: LaunchPlan, options: Mapping[str, Any]) -> int:
     nodes = list(plan.nodes) + (list(plan.tests) if opts.with_tests else [])
     # --- everything that may be the user's fault, before anything starts
     _check_unique_names(nodes)
-    nodes, remote = split_remote(plan, nodes, opts.local)
+    nodes, remote = split_remote(plan, nodes)
     executables = resolve_executables(nodes)
     check_param_actions(plan)
 
@@ -415,8 +406,11 @@ def run_plan(plan: LaunchPlan, options: Mapping[str, Any]) -> int:
 
     watchdog = Watchdog()  # forked first: it must not inherit the master's socket
     master = None
+    session = None
     try:
-        master = connect_master(opts, echo)
+        if remote and not opts.local:     # all-or-nothing: every machine ready, or exit 2
+            session = open_remote(plan, remote, watchdog)
+        master = connect_master(opts, echo, public=session is not None)
         run_dir = prepare_run_log_dir(master.run_id)
         run_param_actions(plan, master.uri, echo)
         upload(plan, master)
@@ -425,11 +419,13 @@ def run_plan(plan: LaunchPlan, options: Mapping[str, Any]) -> int:
         core = [node for node in core if node.full_name in core_exes]
         specs = run_specs(core, nodes, {**executables, **core_exes}, master.uri, run_dir,
                           opts)
+        if session is not None:
+            specs += remote_specs(session, remote, master, run_dir, opts)
         screen = Screen()
         if not opts.disable_title and plan.files_loaded:
             _set_title(" ".join(plan.files_loaded[:1]) + f" {master.uri}")
         echo(f"logging to {run_dir}")
-        for node in remote:
+        for node in remote if opts.local else ():
             echo(f"--local: not starting remote node {node.full_name} "
                  f"(machine {node.machine_name})")
         supervisor = Supervisor(specs, RestartPolicy(backoff_max=opts.backoff_max,
@@ -472,6 +468,8 @@ def run_plan(plan: LaunchPlan, options: Mapping[str, Any]) -> int:
             if master.handle is None:       # roslaunch leaves it behind; we do not
                 _delete_param(master.uri, uris_key)
     finally:
+        if session is not None:
+            session.close()
         if master is not None:
             master.close()
         watchdog.close()
