@@ -157,7 +157,7 @@ class RemoteSession:
                 if os.path.exists(conn.target.control_path):
                     del waiting[name]
                 elif conn.popen.poll() is not None:
-                    raise self._failure(conn, "ssh: " + ssh.explain(self._stderr(conn)))
+                    raise self._failure(conn, ssh.explain(self._stderr(conn)))
                 elif time.monotonic() - start > conn.machine.timeout + 1.0:
                     raise self._failure(conn, f"ssh: no connection within the machine's "
                                               f"timeout ({conn.machine.timeout:g} s)")
@@ -202,19 +202,19 @@ class RemoteSession:
                       err: str) -> RemoteError | None:
         loader = conn.machine.env_loader
         if code == 255:
-            return self._failure(conn, "ssh: " + ssh.explain(err))
+            return self._failure(conn, ssh.explain(err))
         if code in (126, 127) and loader and loader in err:
-            return self._failure(conn, f"env-loader {loader}: {ssh.explain(err)}")
+            return self._failure(conn, f"env-loader {loader}: {ssh.last_line(err)}")
         if "No module named" in err or code == 127:
             return self._failure(conn, "orchestra is not installed there (python3 -m "
-                                       f"orchestra.remote.agent: {ssh.explain(err)}); install "
+                                       f"orchestra.remote.agent: {ssh.last_line(err)}); install "
                                        "it, or make the machine's env-loader put it on the "
                                        "path")
         try:
             report = json.loads(out.strip().splitlines()[-1])
         except (ValueError, IndexError):
             return self._failure(conn, f"the remote check failed (exit code {code}): "
-                                       f"{ssh.explain(err)}")
+                                       f"{ssh.last_line(err)}")
         missing = report.get("missing") or []
         if missing:
             more = f" (and {len(missing) - 1} more)" if len(missing) > 1 else ""

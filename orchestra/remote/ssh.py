@@ -95,13 +95,18 @@ def session_argv(target: SshTarget, command: str, program: str = "ssh") -> list[
             "--", target.address, command]
 
 
-def explain(stderr: str) -> str:
-    """The line of ssh's stderr that says what went wrong (ssh's own words, one line).
+def last_line(stderr: str) -> str:
+    """The line of an stderr that says what went wrong (its own words, one line).
 
     ssh may print warnings first (``Warning: Permanently added ...``); the reason is the
     last non-empty line that is not such a warning.
     """
     lines = [line.strip() for line in stderr.splitlines() if line.strip()]
     useful = [line for line in lines if not line.startswith(("Warning:", "debug"))]
-    chosen = (useful or lines or ["no error message"])[-1]
-    return chosen[:300]
+    return (useful or lines or ["no error message"])[-1][:300]
+
+
+def explain(stderr: str) -> str:
+    """ssh's own failure (exit 255) as one line, prefixed ``ssh:`` when ssh did not."""
+    chosen = last_line(stderr)
+    return chosen if chosen.startswith("ssh:") else f"ssh: {chosen}"
