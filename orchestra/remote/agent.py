@@ -33,13 +33,19 @@ import signal
 import subprocess
 import sys
 import time
-from typing import Any, BinaryIO, Mapping
+from collections.abc import Mapping
+from typing import Any, BinaryIO
 
 from orchestra.errors import OrchestraError
 from orchestra.launch.plan import Node
 from orchestra.remote import payload
-from orchestra.supervise.command import (find_node_executable, node_argv, node_cwd, node_env,
-                                         path_with_interpreter)
+from orchestra.supervise.command import (
+    find_node_executable,
+    node_argv,
+    node_cwd,
+    node_env,
+    path_with_interpreter,
+)
 from orchestra.supervise.output import prepare_run_log_dir
 from orchestra.supervise.reaper import MARK_VARIABLE, child_setup, marked_pids
 

@@ -31,8 +31,8 @@ import subprocess
 import tempfile
 import time
 import urllib.parse
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Callable, Sequence
 
 from orchestra.errors import Location, OrchestraError
 from orchestra.launch.plan import Machine, Node

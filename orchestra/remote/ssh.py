@@ -20,8 +20,8 @@ from __future__ import annotations
 import math
 import os
 import shutil
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Mapping
 
 from orchestra.errors import OrchestraError
 from orchestra.launch.plan import Machine

@@ -24,8 +24,14 @@ import click
 
 from orchestra.errors import Location, OrchestraError
 from orchestra.launch.plan import LaunchPlan, Node
-from orchestra.supervise.command import (find_node_executable, node_argv, node_cwd, node_env,
-                                         path_with_interpreter, ros_home)
+from orchestra.supervise.command import (
+    find_node_executable,
+    node_argv,
+    node_cwd,
+    node_env,
+    path_with_interpreter,
+    ros_home,
+)
 from orchestra.supervise.output import Screen, prepare_run_log_dir
 from orchestra.supervise.process import OutputMode, ProcessSpec, RestartPolicy
 
@@ -352,7 +358,7 @@ def remote_specs(session: Any, remote: list[Node], master: MasterConnection, run
                         options)
     return [replace(spec, cwd=ros_home(), argv=tuple(session.node_argv(
         node, master.uri, master.run_id, spec.log_name or node.name, spec.sigint_timeout,
-        spec.sigterm_timeout))) for node, spec in zip(remote, specs)]
+        spec.sigterm_timeout))) for node, spec in zip(remote, specs, strict=True)]
 
 
 def _is_loopback_uri(uri: str) -> bool:

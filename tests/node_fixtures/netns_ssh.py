@@ -66,7 +66,7 @@ class Testbed:
 
     # ------------------------------------------------------------------ setup / teardown
 
-    def __enter__(self) -> "Testbed":
+    def __enter__(self) -> Testbed:
         try:
             self._network()
             self._keys()
