@@ -29,6 +29,8 @@ COMMANDS: dict[str, str] = {
     "topic": "orchestra.node.cli:topic",
     "service": "orchestra.node.cli:service",
     "graph": "orchestra.node.cli:graph",
+    "bag": "orchestra.bag.cli:bag",
+    "plot": "orchestra.plot.cli:plot",
 }
 
 

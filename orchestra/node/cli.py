@@ -520,31 +520,6 @@ def topic_info(name: str) -> None:
     click.echo("")  # rostopic prints the whole text, then a blank line
 
 
-class _Decoder:
-    """Decode raw messages using the publisher's own definition when ours differs or is
-    missing: echo works for any type, even without its .msg file."""
-
-    def __init__(self):
-        self._classes: dict[tuple[str, str], type[Message]] = {}
-
-    def __call__(self, raw):
-        from orchestra.node.msg import MessageNotFound, get_message_class, message_class_from_definition
-        header = raw._connection_header
-        key = (header.get("type", ""), header.get("md5sum", ""))
-        cls = self._classes.get(key)
-        if cls is None:
-            try:
-                cls = get_message_class(key[0])
-                if cls._md5sum != key[1]:
-                    cls = None
-            except (MessageNotFound, ROSException):
-                cls = None
-            if cls is None:
-                cls = message_class_from_definition(key[0], header.get("message_definition", ""))
-            self._classes[key] = cls
-        return cls.deserialize_bytes(raw._buff)
-
-
 def _subscribe_raw(rospy, name: str):
     from orchestra.node.msg import AnyMsg
     inbox: queue.Queue = queue.Queue()
@@ -560,10 +535,11 @@ def _subscribe_raw(rospy, name: str):
 @click.option("--noarr", is_flag=True, help="Print arrays as their length.")
 def topic_echo(name: str, count: int | None, noarr: bool) -> None:
     """Print each message on NAME as YAML followed by a '---' line."""
+    from orchestra.node.decode import RawDecoder
     from orchestra.node.msg import to_yaml_text
     name = _global(name)
     rospy = _start_cli_node()
-    decode = _Decoder()
+    decode = RawDecoder()
     printed = 0
     try:
         state = introspect.system_state(_master_uri())
