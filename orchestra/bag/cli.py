@@ -215,11 +215,11 @@ def record(topics: tuple[str, ...], all_: bool, regex: str | None, exclude: str 
         split_duration=seconds if split else None, compression=compression or "none",
         buffsize=buffsize * 1024 * 1024, chunksize=chunksize * 1024, limit=limit)
     from orchestra.node.cli import _master_uri, _require_master
-    _require_master(_master_uri())
     try:
         recorder = Recorder(opts)
     except RecordError as exc:
         raise BagError(str(exc)) from None
+    _require_master(_master_uri())
     stop = _stop_on_signals(recorder.stopping)
     try:
         recorder.start()
@@ -282,11 +282,14 @@ def _stop_on_signals(event: threading.Event):
               help="Sleep this long after advertising (default 0.2 s).")
 @click.option("-i", "--immediate", is_flag=True, help="Publish everything at once.")
 @click.option("-q", "--quiet", is_flag=True, help="No progress line.")
+@click.option("--wait-for-subscribers", is_flag=True,
+              help="Start only once every topic has a subscriber.")
 @click.option("--queue", "queue_size", default=100, type=click.IntRange(min=0),
               help="Outgoing queue size per topic (default 100).")
 def play(files: tuple[str, ...], rate: float, start: float, duration: float | None,
          loop: bool, clock: bool, hz: float, topics: tuple[str, ...], pause: bool,
-         delay: float, immediate: bool, quiet: bool, queue_size: int) -> None:
+         delay: float, immediate: bool, quiet: bool, wait_for_subscribers: bool,
+         queue_size: int) -> None:
     """Publish the messages of bags with their recorded timing (as rosbag play).
 
     On a terminal: space pauses and resumes, s publishes one message while paused."""
@@ -295,16 +298,24 @@ def play(files: tuple[str, ...], rate: float, start: float, duration: float | No
     files, extra = _split_topics(files, topics)
     opts = PlayOptions(rate=rate, start=start, duration=duration, loop=loop, clock=clock,
                        hz=hz, topics=extra or None, pause=pause, delay=delay,
-                       immediate=immediate, queue_size=queue_size)
-    _require_master(_master_uri())
-    players = []
-    for path in files:
-        with bag_errors(path):
-            players.append(Player([path], opts))
-    for p in players:
-        p.close()
-    with bag_errors(files[0]):
-        player = Player(list(files), opts)
+                       immediate=immediate, queue_size=queue_size,
+                       wait_for_subscribers=wait_for_subscribers)
+    from orchestra.bag.reader import BagReader
+    readers = []
+    try:
+        for path in files:
+            with bag_errors(path):
+                readers.append(BagReader(path))
+    except BaseException:
+        for reader in readers:
+            reader.close()
+        raise
+    player = Player(readers, opts)
+    try:
+        _require_master(_master_uri())
+    except BaseException:
+        player.close()
+        raise
     import orchestra.node as rospy
     rospy.init_node("play", argv=[], anonymous=True, disable_signals=True,
                     disable_rosout=True, disable_rostime=True)
@@ -328,13 +339,16 @@ def play(files: tuple[str, ...], rate: float, start: float, duration: float | No
             click.echo("\nDone.")
         from orchestra.node.cli import _stop_cli_node
         _stop_cli_node("bag play done")
+    if player.error is not None:
+        raise BagError(f"damaged bag: {player.error}; `orchestra bag reindex` may help")
 
 
 def _split_topics(files: tuple[str, ...], topics: tuple[str, ...]
                   ) -> tuple[tuple[str, ...], list[str]]:
-    """rosbag's ``--topics A B C`` takes the words after it: here they arrive as files
-    that are topic names (they start with '/')."""
-    bags = tuple(f for f in files if not f.startswith("/") or os.path.exists(f))
+    """rosbag's ``--topics A B C`` takes the words after it: here they arrive as files;
+    a word that starts with '/', is no file and does not end in .bag is a topic."""
+    bags = tuple(f for f in files
+                 if not f.startswith("/") or f.endswith(".bag") or os.path.exists(f))
     names = list(topics) + [f for f in files if f not in bags]
     if not bags:
         raise click.UsageError("give at least one bag file")

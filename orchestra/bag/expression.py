@@ -88,9 +88,11 @@ def _check(node: ast.AST, names: frozenset[str]) -> None:
         if isinstance(func, ast.Name):
             if func.id not in _FUNCTIONS:
                 raise ExpressionError(f"function '{func.id}' is not allowed")
-        elif not (isinstance(func, ast.Attribute) and func.attr in _METHODS):
-            raise ExpressionError("only len/abs/min/max/int/float/str/bool/round and the "
-                                  f"methods {', '.join(sorted(_METHODS))} may be called")
+        elif not isinstance(func, ast.Attribute):
+            raise ExpressionError("only named functions and methods may be called")
+        elif func.attr not in _METHODS:
+            raise ExpressionError(f"method '{func.attr}' is not allowed (allowed: "
+                                  f"{', '.join(sorted(_METHODS))})")
 
 
 def _eval(node: ast.AST, env: dict[str, Any]) -> Any:
@@ -125,7 +127,7 @@ def _eval(node: ast.AST, env: dict[str, Any]) -> Any:
         return result
     if isinstance(node, ast.Compare):
         left = _eval(node.left, env)
-        for op, comp in zip(node.ops, node.comparators):
+        for op, comp in zip(node.ops, node.comparators, strict=True):
             right = _eval(comp, env)
             if not _COMPARE[type(op)](left, right):
                 return False

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from typing import Callable, Iterator
 
 from orchestra.bag.reader import BagReader
-from orchestra.bag.records import Connection
+from orchestra.bag.records import BagFormatError, Connection
 
 log = logging.getLogger(__name__)
 
@@ -36,6 +36,7 @@ class PlayOptions:
     delay: float = 0.2  # -d: rosbag's advertise sleep
     immediate: bool = False
     queue_size: int = 100
+    wait_for_subscribers: bool = False
 
 
 @dataclass
@@ -82,15 +83,16 @@ def merged(readers: list[BagReader], topics: list[str] | None, start: int | None
 class Player:
     """Publishes bags; ``run()`` blocks until done or ``stop()``."""
 
-    def __init__(self, paths: list[str], opts: PlayOptions,
+    def __init__(self, readers: list[BagReader], opts: PlayOptions,
                  sleep: Callable[[float], None] = time.sleep):
         self.opts = opts
-        self.readers = [BagReader(p) for p in paths]
+        self.readers = readers
         self.state = PlayState(paused=opts.pause)
         self.stopped = threading.Event()
+        self.error: BagFormatError | None = None
         self._sleep = sleep
         self._pubs: dict[str, tuple[object, str]] = {}
-        self._clock_pub = None
+        self._clock_pub: object | None = None
         self._clock_cls: type | None = None
         self._last_clock = 0.0
         starts = [r.start_time for r in self.readers if r.chunk_infos]
@@ -126,8 +128,23 @@ class Player:
         if self.opts.clock:
             self._clock_cls = rospy.get_message_class("rosgraph_msgs/Clock")
             self._clock_pub = rospy.Publisher("/clock", self._clock_cls, queue_size=1)
+        if self.opts.wait_for_subscribers:
+            self._wait_for_subscribers()
         if self.opts.delay > 0:
             self.stopped.wait(self.opts.delay)
+
+    def _wait_for_subscribers(self) -> None:
+        """Wait until every topic is connected to at least one subscriber and to every
+        subscriber the master listed when we started (rosbag waits for one only: a second
+        subscriber would miss the first messages)."""
+        from orchestra.node.runtime import get_runtime
+        _pubs, subs, _srvs = get_runtime().master.call("getSystemState")
+        listed = {topic: len(nodes) for topic, nodes in subs}
+        for topic, (pub, _md5) in self._pubs.items():
+            need = max(1, listed.get(topic, 0))
+            while pub.get_num_connections() < need:  # type: ignore[attr-defined]
+                if self.stopped.wait(0.01):
+                    return
 
     def _publish(self, conn: Connection, data: bytes) -> None:
         entry = self._pubs.get(conn.topic)
@@ -148,6 +165,15 @@ class Player:
     # --- timing -----------------------------------------------------------------------------
 
     def run(self) -> None:
+        """Play (a damaged chunk met on the way ends playback; ``error`` says why)."""
+        try:
+            self._run()
+        except BagFormatError as exc:
+            self.error = exc
+        finally:
+            self.state.done = True
+
+    def _run(self) -> None:
         opts = self.opts
         first = self.state.first + int(opts.start * NS)
         end = None if opts.duration is None else first + int(opts.duration * NS)
@@ -155,7 +181,6 @@ class Player:
             self._play_once(first, end)
             if not opts.loop or self.stopped.is_set():
                 break
-        self.state.done = True
 
     def _play_once(self, first: int, end: int | None) -> None:
         opts = self.opts

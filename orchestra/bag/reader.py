@@ -220,11 +220,12 @@ class BagReader:
         if topics is not None:
             names = set(topics)
             wanted = {c.id for c in self.connections if c.topic in names}
-        order = sorted(zip(self.chunk_infos, self.chunk_headers), key=lambda p: p[0].start)
+        order = sorted(zip(self.chunk_infos, self.chunk_headers, strict=True),
+                       key=lambda p: p[0].start)
         order = [(i, h) for i, h in order
                  if (start is None or i.end >= start) and (end is None or i.start <= end)
                  and (wanted is None or wanted & set(i.counts))]
-        heap: list[tuple[int, int, int, int, Iterator]] = []
+        heap: list[tuple[int, int, int, tuple[int, bytes], Iterator]] = []
         next_chunk = 0
         while True:
             while next_chunk < len(order) and (not heap or order[next_chunk][0].start

@@ -146,9 +146,9 @@ class BagWriter:
         finally:
             self._abandon()
         if self.failed is not None:
+            kept = sum(sum(i.counts.values()) for i in self._infos)
             raise BagWriteError(f"{self.path}: {self.failed.strerror or self.failed}; "
-                                f"the bag holds the {sum(sum(i.counts.values()) for i in self._infos)}"
-                                " messages written before") from None
+                                f"the bag holds the {kept} messages written before") from None
 
     # --- internals --------------------------------------------------------------------------
 
