@@ -87,9 +87,9 @@ def _duration_text(duration: float) -> str:
     mins = int(duration / 60)
     hrs = int(mins / 60)
     if hrs > 0:
-        return "%dhr %d:%02ds (%ds)" % (hrs, mins % 60, secs, duration)
+        return f"{hrs}hr {mins % 60}:{int(secs):02d}s ({int(duration)}s)"
     if mins > 0:
-        return "%d:%02ds (%ds)" % (mins, secs, duration)
+        return f"{mins}:{int(secs):02d}s ({int(duration)}s)"
     return f"{duration:.1f}s"
 
 

@@ -12,8 +12,8 @@ import heapq
 import logging
 import threading
 import time
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
-from typing import Callable, Iterator
 
 from orchestra.bag.reader import BagReader
 from orchestra.bag.records import BagFormatError, Connection

@@ -9,13 +9,22 @@ from __future__ import annotations
 
 import heapq
 import os
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
-from typing import Iterable, Iterator
 
 from orchestra.bag import chunkcodec
-from orchestra.bag.records import (BAG_HEADER_LEN, MAGIC, U32, BagFormatError, ChunkInfo,
-                                   Connection, Op, Record, decode_header,
-                                   parse_record)
+from orchestra.bag.records import (
+    BAG_HEADER_LEN,
+    MAGIC,
+    U32,
+    BagFormatError,
+    ChunkInfo,
+    Connection,
+    Op,
+    Record,
+    decode_header,
+    parse_record,
+)
 
 
 class NotABag(BagFormatError):
@@ -158,7 +167,7 @@ class BagReader:
     def close(self) -> None:
         self._fh.close()
 
-    def __enter__(self) -> "BagReader":
+    def __enter__(self) -> BagReader:
         return self
 
     def __exit__(self, *exc) -> None:

@@ -181,7 +181,7 @@ class Connection:
                               "topic": self.topic.encode()}, data)
 
     @classmethod
-    def decode(cls, record: Record, data: bytes | memoryview) -> "Connection":
+    def decode(cls, record: Record, data: bytes | memoryview) -> Connection:
         header = {k: v.decode("utf-8", "replace") for k, v in decode_header(data).items()}
         topic = record.text("topic")
         if "type" not in header or "md5sum" not in header:
@@ -208,7 +208,7 @@ class ChunkInfo:
                               "count": U32.pack(len(self.counts))}, data)
 
     @classmethod
-    def decode(cls, record: Record, data: bytes | memoryview) -> "ChunkInfo":
+    def decode(cls, record: Record, data: bytes | memoryview) -> ChunkInfo:
         if record.u32("ver") != 1:
             raise BagFormatError(f"chunk info version {record.u32('ver')} is not supported")
         count = record.u32("count")

@@ -16,8 +16,16 @@ from dataclasses import dataclass, field
 
 from orchestra.bag import chunkcodec
 from orchestra.bag.reader import chunk_records, open_bag_file, read_data, read_record
-from orchestra.bag.records import (BAG_HEADER_LEN, MAGIC, BagFormatError, ChunkInfo,
-                                   Connection, Op, encode_bag_header, encode_index)
+from orchestra.bag.records import (
+    BAG_HEADER_LEN,
+    MAGIC,
+    BagFormatError,
+    ChunkInfo,
+    Connection,
+    Op,
+    encode_bag_header,
+    encode_index,
+)
 
 log = logging.getLogger(__name__)
 

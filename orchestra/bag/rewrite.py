@@ -7,7 +7,7 @@ half-written file under the final name.
 from __future__ import annotations
 
 import os
-from typing import Callable
+from collections.abc import Callable
 
 from orchestra.bag.reader import BagReader
 from orchestra.bag.records import Connection

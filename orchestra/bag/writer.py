@@ -18,8 +18,18 @@ import os
 from dataclasses import dataclass, field
 
 from orchestra.bag import chunkcodec
-from orchestra.bag.records import (MAGIC, ChunkInfo, Connection, Op, U32, encode_bag_header,
-                                   encode_index, encode_message, encode_record, op_field)
+from orchestra.bag.records import (
+    MAGIC,
+    U32,
+    ChunkInfo,
+    Connection,
+    Op,
+    encode_bag_header,
+    encode_index,
+    encode_message,
+    encode_record,
+    op_field,
+)
 
 log = logging.getLogger(__name__)
 
@@ -61,7 +71,7 @@ class BagWriter:
 
     # --- life cycle -------------------------------------------------------------------------
 
-    def open(self) -> "BagWriter":
+    def open(self) -> BagWriter:
         try:
             self._fd = os.open(self.path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
             self._write(MAGIC + encode_bag_header(0, 0, 0))
@@ -71,7 +81,7 @@ class BagWriter:
         self._good_end = len(MAGIC) + len(encode_bag_header(0, 0, 0))
         return self
 
-    def __enter__(self) -> "BagWriter":
+    def __enter__(self) -> BagWriter:
         return self.open()
 
     def __exit__(self, *exc) -> None:

@@ -8,8 +8,7 @@ built from the definition that travelled with it, so any type decodes, even with
 from __future__ import annotations
 
 from orchestra.node.exceptions import ROSException
-from orchestra.node.msg import (Message, MessageNotFound, get_message_class,
-                                message_class_from_definition)
+from orchestra.node.msg import Message, MessageNotFound, get_message_class, message_class_from_definition
 
 
 class RawDecoder:
