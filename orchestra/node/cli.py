@@ -11,7 +11,6 @@ import math
 import queue
 import re
 import time
-from typing import TYPE_CHECKING
 
 import click
 import yaml
@@ -20,9 +19,6 @@ from orchestra.errors import OrchestraError
 from orchestra.node import introspect
 from orchestra.node.exceptions import ROSException
 from orchestra.node.loggers import LEVEL_NAMES
-
-if TYPE_CHECKING:
-    from orchestra.node.msg import Message
 
 CLI_NODE = "orchestra_cli"
 
