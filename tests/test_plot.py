@@ -1,0 +1,93 @@
+"""``orchestra plot``: field specs as rqt_plot reads them, and the picture itself: the curve
+is found in the PNG's pixels where the data puts it (and not where it does not)."""
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import pytest
+
+from orchestra.bag.writer import BagWriter
+from orchestra.node.msg import get_message_class
+from orchestra.plot.series import SpecError, parse_path, parse_spec
+
+T0 = 1_700_000_000 * 10**9
+C0 = (0x1F / 255, 0x77 / 255, 0xB4 / 255)  # matplotlib's first line colour
+
+
+def test_spec_names_fields_of_the_longest_topic_prefix():
+    topics = ["/turtle1/pose", "/turtle1", "/scan"]
+    got = parse_spec("/turtle1/pose/x:y", topics)
+    assert [(s.topic, s.path, s.label) for s in got] == [
+        ("/turtle1/pose", ["x"], "/turtle1/pose/x"), ("/turtle1/pose", ["y"], "/turtle1/pose/y")]
+    assert parse_path("ranges[3]") == ["ranges", 3]
+    assert parse_spec("/scan/ranges[3]", topics)[0].label == "/scan/ranges[3]"
+    with pytest.raises(SpecError, match="no such topic"):
+        parse_spec("/nope/x", topics)
+    with pytest.raises(SpecError, match="name a numeric field"):
+        parse_spec("/scan", topics)
+
+
+def _triangle(t: float) -> float:
+    return t if t <= 5 else 10 - t
+
+
+def _bag(path) -> None:
+    cls = get_message_class("std_msgs/Float64")
+    w = BagWriter(str(path)).open()
+    conn = w.add_connection("/value", {"type": cls._type, "md5sum": cls._md5sum,
+                                       "message_definition": cls._full_text,
+                                       "callerid": "/gen", "latching": "0"})
+    for i in range(201):
+        t = i * 0.05
+        w.write(conn, T0 + int(t * 1e9), bytes(cls(data=_triangle(t)).serialize_bytes()))
+    w.close()
+
+
+def _near_curve(img, row: float, col: float, radius: int = 3) -> bool:
+    import numpy as np
+    r, c = int(round(row)), int(round(col))
+    assert radius <= r < img.shape[0] - radius and radius <= c < img.shape[1] - radius
+    patch = img[max(0, r - radius):r + radius + 1, max(0, c - radius):c + radius + 1, :3]
+    return bool((np.abs(patch - np.array(C0)).sum(axis=2) < 0.25).any())
+
+
+def test_plot_png_draws_the_curve_where_the_data_is(tmp_path):
+    import matplotlib.image
+
+    from orchestra.plot import figure
+    from orchestra.plot.cli import series_from_bag
+    bag = tmp_path / "tri.bag"
+    _bag(bag)
+    series = series_from_bag(str(bag), ("/value/data",))
+    out = tmp_path / "tri.png"
+    fig = figure.save(series, str(out))
+    img = matplotlib.image.imread(str(out))
+    height = img.shape[0]
+    ax = fig.axes[0]
+    for t in (1.0, 2.5, 4.0, 6.0, 8.5):
+        x, y = ax.transData.transform((t, _triangle(t)))
+        assert _near_curve(img, height - y, x), f"no curve at t={t}"
+        away = _triangle(t) + (2.5 if _triangle(t) < 2.5 else -2.5)
+        x, y = ax.transData.transform((t, away))
+        assert not _near_curve(img, height - y, x), f"curve where the data is not, t={t}"
+
+
+def test_plot_cli_writes_a_picture_from_a_bag_and_rejects_bad_specs(tmp_path):
+    bag = tmp_path / "tri.bag"
+    _bag(bag)
+    run = [sys.executable, "-m", "orchestra", "plot", "--bag", str(bag)]
+    env = dict(os.environ)
+    env.pop("DISPLAY", None)
+    ok = subprocess.run(run + ["/value/data", "--out", str(tmp_path / "p.svg")],
+                        capture_output=True, text=True, env=env)
+    assert ok.returncode == 0, ok.stderr
+    assert (tmp_path / "p.svg").read_text().lstrip().startswith("<?xml")
+    for spec, problem in (("/value/nope", "has no field"), ("/other/x", "no such topic")):
+        bad = subprocess.run(run + [spec, "--out", str(tmp_path / "q.png")],
+                             capture_output=True, text=True, env=env)
+        assert bad.returncode == 2 and problem in bad.stderr, bad.stderr
+        assert len(bad.stderr.strip().splitlines()) == 1
+    nodisplay = subprocess.run(run + ["/value/data"], capture_output=True, text=True, env=env)
+    assert nodisplay.returncode == 2 and "--out" in nodisplay.stderr
