@@ -31,6 +31,7 @@ COMMANDS: dict[str, str] = {
     "graph": "orchestra.node.cli:graph",
     "bag": "orchestra.bag.cli:bag",
     "plot": "orchestra.plot.cli:plot",
+    "env": "orchestra.ros1.cli:env",
 }
 
 

@@ -95,10 +95,19 @@ def test_constructor_defaults_every_field_and_builds_nested_messages():
 def test_constructor_takes_keywords_or_positional_values_and_rejects_unknown_fields():
     Vector3 = get_message_class("geometry_msgs/Vector3")
     assert Vector3(1.0, 2.0, 3.0) == Vector3(x=1.0, y=2.0, z=3.0)
-    with pytest.raises(AttributeError, match="not a field"):
+    with pytest.raises(AttributeError, match="w is not an attribute of Vector3"):
         Vector3(w=1.0)
-    with pytest.raises(TypeError):
+    with pytest.raises(TypeError, match="Invalid number of arguments"):
         Vector3(1.0, 2.0)
+    with pytest.raises(TypeError, match="args OR keywords, not both"):
+        Vector3(1.0, y=2.0, z=3.0)
+
+
+def test_constructor_gives_defaults_for_fields_left_out_or_none_as_genpy():
+    Pose = get_message_class("geometry_msgs/PoseStamped")
+    p = Pose(header=None)
+    assert p.header.frame_id == "" and p.pose.orientation.w == 0.0
+    assert Pose(None, None) == Pose()
 
 
 def test_class_exposes_type_md5_full_text_and_constants():

@@ -15,14 +15,11 @@ from typing import Any
 
 import yaml
 
-from orchestra.node import msgspec
+from orchestra.node import msgdefs, msgspec
 from orchestra.node.exceptions import ROSException, SerializationError
 from orchestra.node.msgspec import MsgSpec, SrvSpec
 from orchestra.node.rostime import Duration, Time
 from orchestra.node.serialization import compile_codec
-
-DEFINITIONS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "definitions")
-
 
 class MessageNotFound(ROSException):
     """No definition of a message or service type could be found."""
@@ -41,21 +38,24 @@ class Message:
     _spec: MsgSpec | None = None
 
     def __init__(self, *args, **kwargs):
+        # genpy's rules and messages: positional values for ALL fields, or keywords for
+        # some; a field left out or given as None gets its default
         if args and kwargs:
-            raise TypeError("a message takes positional OR keyword field values, not both")
+            raise TypeError("Message constructor may only use args OR keywords, not both")
         self._defaults(self)
         if args:
             if len(args) != len(self._fields):
-                raise TypeError(f"{self._type} takes {len(self._fields)} field values "
-                                f"({', '.join(self._fields)}), got {len(args)}")
-            for name, value in zip(self._fields, args, strict=False):
-                setattr(self, name, value)
+                raise TypeError(f"Invalid number of arguments, args should be "
+                                f"{list(self._fields)} args are{args}")
+            for name, value in zip(self._fields, args, strict=True):
+                if value is not None:
+                    setattr(self, name, value)
             return
         for name, value in kwargs.items():
             if name not in self._fields:
-                raise AttributeError(f"{name!r} is not a field of {self._type} "
-                                     f"(fields: {', '.join(self._fields) or 'none'})")
-            setattr(self, name, value)
+                raise AttributeError(f"{name} is not an attribute of {type(self).__name__}")
+            if value is not None:
+                setattr(self, name, value)
 
     @staticmethod
     def _defaults(m) -> None:  # replaced per class
@@ -99,16 +99,19 @@ class Message:
 
     # --- python niceties ----------------------------------------------------------------
     def __eq__(self, other) -> bool:
-        if type(other) is not type(self):
+        if not isinstance(other, type(self)):
             return False
         for name in self._fields:
             a, b = getattr(self, name), getattr(other, name)
             if isinstance(a, (list, tuple)) and isinstance(b, (list, tuple)):
-                if list(a) != list(b):
+                if tuple(a) != tuple(b):
                     return False
             elif a != b:
                 return False
         return True
+
+    def __ne__(self, other) -> bool:
+        return not self == other
 
     __hash__ = None  # mutable
 
@@ -179,51 +182,6 @@ class Registry:
         self._classes: dict[str, type[Message]] = {}
         self._srv_classes: dict[str, type[ServiceDefinition]] = {}
         self._parent = parent
-        self._typestore = None
-
-    # sources ------------------------------------------------------------------------------
-    def _store(self):
-        if self._typestore is None:
-            from rosbags.typesys import Stores, get_typestore
-            self._typestore = get_typestore(Stores.ROS1_NOETIC)
-        return self._typestore
-
-    def _from_typestore(self, msg_type: str) -> bool:
-        pkg, _, name = msg_type.partition("/")
-        store = self._store()
-        key = f"{pkg}/msg/{name}"
-        if key not in store.fielddefs:
-            return False
-        text, md5 = store.generate_msgdef(key)
-        for sub_type, spec in msgspec.parse_full_text(text, msg_type).items():
-            self._specs.setdefault(sub_type, spec)
-        self._md5[msg_type] = md5
-        return True
-
-    @staticmethod
-    def _definition_file(pkg: str, kind: str, name: str) -> str | None:
-        bundled = os.path.join(DEFINITIONS, pkg, kind, f"{name}.{kind}")
-        if os.path.isfile(bundled):
-            return bundled
-        from orchestra.errors import OrchestraError
-        from orchestra.packages import find_package
-        try:
-            directory = find_package(pkg)
-        except OrchestraError:
-            return None
-        path = os.path.join(directory, kind, f"{name}.{kind}")
-        return path if os.path.isfile(path) else None
-
-    def _read_definition(self, type_name: str, kind: str, why: str = "") -> tuple[str, str]:
-        """(path, text) of the ``.msg``/``.srv`` file defining ``pkg/Name``, or MessageNotFound."""
-        pkg, _, name = type_name.partition("/")
-        path = self._definition_file(pkg, kind, name)
-        if path is None:
-            noun = "message" if kind == "msg" else "service"
-            raise MessageNotFound(f"cannot find {noun} type {type_name} "
-                                  f"({why}no {pkg}/{kind}/{name}.{kind} in a package)")
-        with open(path, encoding="utf-8") as fh:
-            return path, fh.read()
 
     def spec(self, msg_type: str) -> MsgSpec:
         msg_type = normalise_type(msg_type)
@@ -238,10 +196,13 @@ class Registry:
                     pass
             if "/" not in msg_type:
                 raise MessageNotFound(f"message type {msg_type!r} must be 'package/Name'")
-            if self._from_typestore(msg_type):
-                return self._specs[msg_type]
-            path, text = self._read_definition(msg_type, "msg", "not a standard type, and ")
-            spec = msgspec.parse_msg(text, msg_type, path)
+            definition = msgdefs.find_message(msg_type)
+            if definition is None:
+                pkg, _, name = msg_type.partition("/")
+                raise MessageNotFound(f"cannot find message type {msg_type} (not a standard "
+                                      f"type, and no {pkg}/msg/{name}.msg in a package)")
+            spec = msgspec.parse_msg(definition.text, msg_type, definition.path or None,
+                                     definition.first_line)
             self._specs[msg_type] = spec
             return spec
 
@@ -273,8 +234,23 @@ class Registry:
                 cls = self._build(self.spec(msg_type))
             return cls
 
+    def _nested(self, spec: MsgSpec) -> dict[str, type[Message]]:
+        """The classes of ``spec``'s nested types; an unknown one is an error of ``spec``'s
+        definition, named at the line of the field that uses it."""
+        nested: dict[str, type[Message]] = {}
+        for f in spec.fields:
+            if f.is_builtin or f.base in nested:
+                continue
+            try:
+                nested[f.base] = self.message_class(f.base)
+            except MessageNotFound:
+                raise msgspec.MsgSpecError(
+                    f"{spec.where(f)}: unknown type {f.base!r} of field '{f.name}' in "
+                    f"{spec.type} (no such message type)") from None
+        return nested
+
     def _build(self, spec: MsgSpec, md5: str | None = None) -> type[Message]:
-        nested = {dep: self.message_class(dep) for dep in spec.dependencies()}
+        nested = self._nested(spec)
         attrs: dict[str, Any] = {
             "__slots__": tuple(f.name for f in spec.fields),
             "_type": spec.type,
@@ -305,8 +281,12 @@ class Registry:
                 return cls
             if "/" not in srv_type:
                 raise MessageNotFound(f"service type {srv_type!r} must be 'package/Name'")
-            path, text = self._read_definition(srv_type, "srv")
-            spec = msgspec.parse_srv(text, srv_type, path)
+            definition = msgdefs.find_service(srv_type)
+            if definition is None:
+                pkg, _, name = srv_type.partition("/")
+                raise MessageNotFound(f"cannot find service type {srv_type} "
+                                      f"(no {pkg}/srv/{name}.srv in a package)")
+            spec = msgspec.parse_srv(definition.text, srv_type, definition.path or None)
             cls = self._build_service(spec)
             self._srv_classes[srv_type] = cls
             return cls
@@ -316,6 +296,7 @@ class Registry:
             self._specs[part.type] = part
         request = self.message_class(spec.request.type)
         response = self.message_class(spec.response.type)
+        request.__module__ = response.__module__ = f"{spec.type.split('/')[0]}.srv"
         md5 = msgspec.compute_srv_md5(spec, self.spec, self.md5)
         return type(spec.type.split("/")[1], (ServiceDefinition,), {
             "_type": spec.type, "_md5sum": md5,
@@ -366,20 +347,20 @@ def _strify(value: Any, indent: str, slot_type: str = "") -> str:
     if isinstance(value, str):
         if not value:
             return "''"
-        return yaml.dump(value, default_style='"', width=float("inf")).rstrip("\n")
+        return yaml.dump(value, default_style='"').rstrip("\n")
     if isinstance(value, (Time, Duration)):
         return f"\n{indent}secs: {value.secs}\n{indent}nsecs: {value.nsecs:9d}"
-    if isinstance(value, (bytes, bytearray)):
-        value = list(value)
+    if isinstance(value, (bytes, bytearray)) and (not slot_type or "uint8[" in slot_type):
+        value = list(value)   # genpy shows uint8[] as numbers (char[] stays bytes)
     if isinstance(value, (list, tuple)):
         if not value:
             return "[]"
         first = value[0]
         if isinstance(first, str):
             # genpy: a YAML block list, one "- item" line per string at this field's indent
-            text = yaml.dump(list(value), default_flow_style=False, width=float("inf"))
+            text = yaml.dump(list(value), default_flow_style=False)
             return "\n" + "\n".join(indent + line for line in text.splitlines())
-        if isinstance(first, (int, float, bool)):
+        if type(first) in (int, float, bool):
             return str(list(value))
         prefix = indent + "- "
         inner = indent + "  "

@@ -157,16 +157,21 @@ def deps_cmd(name: str, direct: bool, kinds: tuple[str, ...], reverse: bool, mis
 def run(prefix: str | None, package: str, exe: str, args: tuple[str, ...]) -> None:
     """Run executable EXE of PACKAGE with ARGS (like rosrun).
 
-    The executable replaces this process, so signals and the exit code are its own.
+    The executable replaces this process, so signals and the exit code are its own. A Python
+    node gets orchestra's ROS 1 layer (rospy, <pkg>.msg...) unless a real rospy is
+    importable, as under ``orchestra launch`` (docs/rospy-layer.md).
     """
     from orchestra.packages.executables import find_executable
+    from orchestra.ros1.activation import layer_env
 
     path = find_executable(package, exe)
     argv = (shlex.split(prefix) if prefix else []) + [path, *args]
     sys.stdout.flush()
     sys.stderr.flush()
+    env = dict(os.environ)
+    env.update(layer_env(env))
     try:
-        os.execvp(argv[0], argv)
+        os.execvpe(argv[0], argv, env)
     except OSError as exc:
         raise OrchestraError(f"cannot execute {argv[0]}: {exc.strerror}") from None
 

@@ -24,6 +24,7 @@ import click
 
 from orchestra.errors import Location, OrchestraError
 from orchestra.launch.plan import LaunchPlan, Node
+from orchestra.ros1.activation import layer_env
 from orchestra.supervise.command import (
     find_node_executable,
     node_argv,
@@ -191,6 +192,7 @@ def build_specs(nodes: list[Node], executables: Mapping[str, str], master_uri: s
     # and the console shows it late (roslaunch leaves screen nodes on the TTY instead)
     base.setdefault("PYTHONUNBUFFERED", "1")
     base["PATH"] = path_with_interpreter(base.get("PATH", ""), sys.executable)
+    base.update(layer_env(base))   # rospy & co. for Python nodes without ROS (ros1/activation)
     specs = []
     for counter, node in enumerate(nodes, start=1):
         exe = executables[node.full_name]
