@@ -203,3 +203,9 @@ def test_orchestra_env_prints_lines_a_shell_can_eval(tmp_path):
                            capture_output=True, text=True, timeout=60)
     assert shell.stdout.split() == ["layer",
                                     os.pathsep.join([activation.SITE_DIR, str(REPO)])]
+
+
+def test_a_node_importing_orchestra_directly_is_not_disturbed_by_the_layer():
+    # orchestra.node's own imports probe optional modules (copy.py's "org") half-way through
+    out = _run(sys.executable, "import orchestra.node, copy; print('ok')")
+    assert out.returncode == 0 and out.stdout.strip() == "ok", out.stderr

@@ -9,7 +9,6 @@ constructor taking positional or keyword field values (every other field default
 """
 from __future__ import annotations
 
-import os
 import threading
 from typing import Any
 
@@ -20,6 +19,7 @@ from orchestra.node.exceptions import ROSException, SerializationError
 from orchestra.node.msgspec import MsgSpec, SrvSpec
 from orchestra.node.rostime import Duration, Time
 from orchestra.node.serialization import compile_codec
+
 
 class MessageNotFound(ROSException):
     """No definition of a message or service type could be found."""

@@ -15,8 +15,8 @@ environment and ``sitecustomize`` uses it inside every node, before anything els
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping, Sequence
 from importlib.machinery import PathFinder
-from typing import Mapping, Sequence
 
 ENV_VAR = "ORCHESTRA_ROS1"
 MODES = ("auto", "layer", "real")

@@ -26,7 +26,8 @@ import os
 import sys
 import threading
 import types
-from typing import Any, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 KINDS = ("msg", "srv")
 #: modules Python itself looks for at start-up: never ROS packages, and answering them would
@@ -36,9 +37,18 @@ _busy = threading.local()
 
 
 def _reentrant() -> bool:
-    """True while one of our finders is already working in this thread: the imports it does
-    itself (orchestra's modules, the standard library's optional probes) are not ours."""
-    return getattr(_busy, "depth", 0) > 0
+    """True while our finders cannot answer: one of them is already working in this thread
+    (the imports it does itself are not ours), or some orchestra module is half-imported (a
+    node importing orchestra.node, whose imports probe optional modules such as copy.py's
+    ``org``): answering would use that half-made module."""
+    if getattr(_busy, "depth", 0) > 0:
+        return True
+    for name, module in list(sys.modules.items()):
+        if name.startswith("orchestra.") or name == "orchestra":
+            spec = getattr(module, "__spec__", None)
+            if spec is not None and getattr(spec, "_initializing", False):
+                return True
+    return False
 
 
 class _Working:
@@ -80,7 +90,7 @@ def _make_getattr(module: types.ModuleType, pkg: str, kind: str):
             names = _definitions().package_types(pkg, kind)
             if kind == "srv":   # genpy's srv modules also export <Srv>Request/<Srv>Response
                 names = sorted(names + [n + s for n in names for s in ("Request", "Response")])
-            module.__all__ = names
+            setattr(module, "__all__", names)  # noqa: B010 - a module attribute
             return names
         if attr.startswith("__") or not attr[:1].isalpha():
             raise AttributeError(f"module {module.__name__!r} has no attribute {attr!r}")
@@ -126,7 +136,7 @@ class _MessageModuleLoader(importlib.abc.Loader):
                         raise
                     service = plain(part[0])
                     return getattr(service, f"_{part[1].lower()}_class")
-        module.__getattr__ = getattr_  # type: ignore[attr-defined]
+        setattr(module, "__getattr__", getattr_)  # noqa: B010 - PEP 562 module hook
         module.__doc__ = f"{kind} classes of package {pkg} (orchestra's ROS 1 layer)"
 
 
