@@ -210,3 +210,10 @@ def test_error_in_included_file_keeps_its_location_and_names_the_include(write):
         launch(write, '\n\n<include file="$(dirname)/inc.launch"/>')
     assert info.value.location.file.endswith("inc.launch") and info.value.location.line == 2
     assert "included from" in str(info.value) and "main.launch:3" in str(info.value)
+
+
+def test_output_both_is_accepted_and_other_modes_are_refused(write):
+    plan = launch(write, '<node name="n" pkg="p" type="t" output="both"/>')
+    assert plan.nodes[0].output == "both"
+    with pytest.raises(OrchestraError, match="'log', 'screen', 'both'"):
+        launch(write, '<node name="n" pkg="p" type="t" output="loud"/>')

@@ -164,3 +164,24 @@ def test_core_serves_rosout_agg_and_stops_rosout_on_exit(env, spawn):
     assert not psutil.pid_exists(rosout[0].pid) or rosout[0].status() == psutil.STATUS_ZOMBIE
     run_dir = env["tmp"] / "home" / "log" / "latest"
     assert "hello from talker" in (run_dir / "rosout.log").read_text()
+
+
+def test_a_launch_stopped_while_rosout_starts_ends_quietly(env, spawn):
+    """SIGINT the moment /rosout is spawned (its interpreter still importing): it ends with
+    the run, silently: no 'Fatal Python error', no traceback on the console."""
+    (env["tmp"] / "empty.launch").write_text("<launch/>\n")
+    for attempt in range(6):
+        proc = spawn([*ORCHESTRA, "launch", str(env["tmp"] / "empty.launch"), "--no-status"],
+                     {**env["env"], "ROS_MASTER_URI": f"http://127.0.0.1:{free_port()}/"},
+                     stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        seen = []
+        for line in proc.stdout:
+            seen.append(line)
+            if "process[/rosout]: started" in line:
+                break
+        proc.send_signal(signal.SIGINT)
+        rest = proc.communicate(timeout=30)[0]
+        console = "".join(seen) + rest
+        assert proc.returncode == 0, console
+        assert "Traceback" not in console and "Fatal Python error" not in console, \
+            (attempt, console)

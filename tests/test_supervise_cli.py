@@ -249,3 +249,23 @@ def _peek_stderr(proc) -> bytes:
         fcntl.fcntl(fd, fcntl.F_SETFL, flags)
     _STDERR[proc.pid] = _STDERR.get(proc.pid, b"") + chunk
     return _STDERR[proc.pid]
+
+
+def test_output_both_writes_the_console_and_the_log_file(launch_env):
+    """output="both" (an orchestra extension, as ROS 2's launch): stdout lines reach the
+    console, prefixed, and the node's log file."""
+    Path(launch_env["launch"]).write_text(
+        '<launch>\n  <node pkg="demo" type="talker" name="t" output="both"/>\n</launch>\n')
+    talker = Path(launch_env["launch"]).parent.parent / "nodes" / "talker"
+    talker.write_text("#!/bin/sh\necho both-line\ntrap 'exit 0' INT TERM\n"
+                      "while :; do sleep 0.2; done\n")
+    talker.chmod(0o755)
+    log_dir = launch_env["tmp"] / "home" / "log" / "latest"
+    with running(launch_env) as proc:
+        deadline = time.monotonic() + 30
+        while not any("both-line" in p.read_text() for p in log_dir.glob("t-*-stdout.log")):
+            assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
+            time.sleep(0.05)
+        out, err = finish(proc, signal.SIGINT)
+    assert proc.returncode == 0, err
+    assert "[/t] both-line" in out

@@ -24,7 +24,7 @@ from orchestra.errors import Location, OrchestraError
 from orchestra.launch.context import Scope, ScopeError
 from orchestra.launch.entity import Entity
 from orchestra.launch.files import read_bytes, read_text
-from orchestra.launch.plan import LaunchPlan, Machine, Node, ParamAction, Test
+from orchestra.launch.plan import OUTPUT_MODES, LaunchPlan, Machine, Node, ParamAction, Test
 from orchestra.launch.substitution import ArgNotSet, SubstitutionError, resolve
 from orchestra.launch.values import bool_attribute, convert_value, float_attribute
 from orchestra.names import canonicalize, is_legal_name, is_private, make_global_ns, ns_join
@@ -636,8 +636,9 @@ class Interpreter:
             self.tests.append(Test(output="log", test_name=test_name, time_limit=time_limit,
                                    retry=retry, **common))
             return
-        if output not in ("log", "screen", None):
-            raise self._error(entity, "must be one of 'log', 'screen'", "output")
+        if output is not None and output not in OUTPUT_MODES:
+            raise self._error(entity, "must be one of "
+                              + ", ".join(f"'{mode}'" for mode in OUTPUT_MODES), "output")
         node = Node(respawn=respawn_flag, respawn_delay=delay, output=output,
                     required=required_flag, **common)
         full = node.full_name

@@ -39,6 +39,11 @@ class Machine:
         }
 
 
+# ``output=`` values: roslaunch's ``log`` and ``screen``, and ``both`` (log file and console,
+# as ROS 2's launch has it), an orchestra extension.
+OUTPUT_MODES = ("log", "screen", "both")
+
+
 @dataclass(frozen=True)
 class Node:
     """A ``<node>`` resolved: its full name is ``namespace + name``.

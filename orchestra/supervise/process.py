@@ -96,6 +96,10 @@ class ProcessSpec:
     sigterm_timeout: float = 2.0
     location: str | None = None
     limits: Limits = field(default_factory=Limits)
+    # started with SIGINT blocked: the program unblocks it once its handlers are installed
+    # (orchestra's own core nodes do), so a stop that comes while its interpreter is still
+    # starting is delivered then and ends it cleanly, not mid-import with a traceback
+    sigint_held: bool = False
 
 
 @dataclass(frozen=True)

@@ -169,17 +169,24 @@ class Watchdog:
         #: the value of MARK_VARIABLE in every node's environment (unique to this run)
         self.mark = new_mark()
         read_fd, write_fd = os.pipe()
-        with warnings.catch_warnings():
-            # Python >= 3.12 warns about fork() with threads running (an embedded master in
-            # tests); the child only makes raw system calls, which is fork-safe
-            warnings.simplefilter("ignore", DeprecationWarning)
-            pid = os.fork()
-        if pid == 0:  # child
-            try:
-                os.close(write_fd)
-                _watchdog_main(read_fd, self.mark)
-            finally:
-                os._exit(0)
+        # the stop signals stay blocked across the fork until the child ignores them: a
+        # Ctrl-C at that instant must not raise KeyboardInterrupt in the child
+        stops = {signal.SIGINT, signal.SIGTERM, signal.SIGHUP}
+        held = signal.pthread_sigmask(signal.SIG_BLOCK, stops)
+        try:
+            with warnings.catch_warnings():
+                # Python >= 3.12 warns about fork() with threads running (an embedded master
+                # in tests); the child only makes raw system calls, which is fork-safe
+                warnings.simplefilter("ignore", DeprecationWarning)
+                pid = os.fork()
+            if pid == 0:  # child
+                try:
+                    os.close(write_fd)
+                    _watchdog_main(read_fd, self.mark, held)
+                finally:
+                    os._exit(0)
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, held)
         os.close(read_fd)
         self.pid = pid
         self._fd: int | None = write_fd
@@ -212,9 +219,10 @@ class Watchdog:
             pass
 
 
-def _watchdog_main(read_fd: int, mark: str) -> None:
+def _watchdog_main(read_fd: int, mark: str, mask: Iterable[int]) -> None:
     for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP, signal.SIGPIPE):
         signal.signal(sig, signal.SIG_IGN)
+    signal.pthread_sigmask(signal.SIG_SETMASK, mask)
     try:
         os.setsid()   # a kill aimed at orchestra's process group must not take us along
     except OSError:

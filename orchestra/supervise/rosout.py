@@ -16,6 +16,7 @@ warning: a missing log aggregator is no reason to refuse to start a robot.
 from __future__ import annotations
 
 import logging
+import os
 import threading
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
@@ -55,6 +56,16 @@ def resolve_core_executables(nodes: Sequence[Node], warn: Callable[[str], None]
     return found
 
 
+def releases_sigint(executable: str) -> bool:
+    """Whether ``executable`` is orchestra's own rosout, which unblocks SIGINT itself once its
+    handlers are installed (so it may be started with SIGINT held: see ``ProcessSpec``). A
+    rosout found elsewhere (a real ROS install) is started like any node."""
+    from orchestra.packages.index import BUNDLED_PACKAGES
+
+    bundled = os.path.realpath(os.path.join(BUNDLED_PACKAGES, ROSOUT.package)) + os.sep
+    return os.path.realpath(executable).startswith(bundled)
+
+
 def serve_core(handle, run_id: str, rosout: bool, watchdog, echo: Callable[[str], None],
                announce: Callable[[], None] | None = None) -> RunResult:
     """``orchestra core`` after its master is up: supervise the core nodes until a signal or
@@ -65,14 +76,14 @@ def serve_core(handle, run_id: str, rosout: bool, watchdog, echo: Callable[[str]
     runs once those signals are handled, before /rosout is spawned.
     """
     from orchestra.supervise.output import prepare_run_log_dir
-    from orchestra.supervise.runner import RunOptions, build_specs
+    from orchestra.supervise.runner import RunOptions, run_specs
     from orchestra.supervise.supervisor import Supervisor
 
     nodes = core_nodes((), embedded_master=True, enabled=rosout)
     executables = resolve_core_executables(nodes, echo)
     nodes = [node for node in nodes if node.full_name in executables]
     run_dir = prepare_run_log_dir(run_id) if nodes else None
-    specs = build_specs(nodes, executables, handle.uri, run_dir, RunOptions()) if nodes else []
+    specs = run_specs(nodes, [], executables, handle.uri, run_dir, RunOptions()) if nodes else []
     supervisor = Supervisor(specs, log_dir=run_dir, watchdog=watchdog, keep_alive=True)
 
     def stop_with_master() -> None:

@@ -217,9 +217,14 @@ def run_specs(core: list[Node], nodes: list[Node], executables: Mapping[str, str
               master_uri: str, run_dir: str, options: RunOptions) -> list[ProcessSpec]:
     """The specs of a run: roscore's nodes first (so they count from 1, as with roslaunch),
     then the plan's. ``--required`` is about the plan's nodes: a core node respawns rather
-    than ending the launch."""
+    than ending the launch. orchestra's own core nodes start with SIGINT held until they can
+    take it (``ProcessSpec.sigint_held``): a launch stopped at once ends them quietly."""
+    from orchestra.supervise.rosout import releases_sigint
+
     specs = build_specs(core + nodes, executables, master_uri, run_dir, options)
-    return [replace(spec, required=False) for spec in specs[:len(core)]] + specs[len(core):]
+    return [replace(spec, required=False,
+                    sigint_held=releases_sigint(executables[node.full_name]))
+            for node, spec in zip(core, specs, strict=False)] + specs[len(core):]
 
 
 @dataclass

@@ -302,11 +302,18 @@ class Supervisor:
             if self.pdeathsig == "setpriv":
                 check_executable(argv[0], spec.env, spec.cwd)
                 argv = [*(setpriv_prefix() or ()), *argv]  # checked at __init__
-            popen = subprocess.Popen(
-                argv, cwd=spec.cwd, env={**spec.env, MARK_VARIABLE: self.mark},
-                stdin=None,  # inherited, as roslaunch
-                stdout=subprocess.PIPE, stderr=subprocess.PIPE, close_fds=True,
-                start_new_session=True, preexec_fn=preexec)
+            # the child inherits this thread's signal mask through fork and exec
+            held = (signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+                    if spec.sigint_held else None)
+            try:
+                popen = subprocess.Popen(
+                    argv, cwd=spec.cwd, env={**spec.env, MARK_VARIABLE: self.mark},
+                    stdin=None,  # inherited, as roslaunch
+                    stdout=subprocess.PIPE, stderr=subprocess.PIPE, close_fds=True,
+                    start_new_session=True, preexec_fn=preexec)
+            finally:
+                if held is not None:
+                    signal.pthread_sigmask(signal.SIG_SETMASK, held)
         except (OSError, subprocess.SubprocessError) as exc:
             self._spawn_failed(proc, exc)
             return
