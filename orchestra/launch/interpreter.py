@@ -26,7 +26,7 @@ from orchestra.launch.entity import Entity
 from orchestra.launch.files import read_bytes, read_text
 from orchestra.launch.plan import OUTPUT_MODES, LaunchPlan, Machine, Node, ParamAction, Test
 from orchestra.launch.substitution import ArgNotSet, SubstitutionError, resolve
-from orchestra.launch.values import bool_attribute, convert_value, float_attribute
+from orchestra.launch.values import bool_attribute, convert_value, float_attribute, size_attribute
 from orchestra.names import canonicalize, is_legal_name, is_private, make_global_ns, ns_join
 
 log = logging.getLogger(__name__)
@@ -36,8 +36,11 @@ DEFAULT_TIMEOUT = 10.0
 TEST_TIME_LIMIT = 60.0
 
 IF_UNLESS = frozenset({"if", "unless"})
-NODE_ATTRS = IF_UNLESS | {"pkg", "type", "machine", "name", "args", "output", "respawn", "respawn_delay",
-              "cwd", "ns", "clear_params", "launch-prefix", "required"}
+# rosmon's extensions, honoured by the supervisor (docs/compat.md): not unknown attributes
+ROSMON_NODE_ATTRS = frozenset({"stop-timeout", "memory-limit", "cpu-limit", "enable-coredumps"})
+NODE_ATTRS = IF_UNLESS | ROSMON_NODE_ATTRS | {
+    "pkg", "type", "machine", "name", "args", "output", "respawn", "respawn_delay", "cwd", "ns",
+    "clear_params", "launch-prefix", "required"}
 TEST_ATTRS = NODE_ATTRS | {"test-name", "time-limit", "retry"}
 MACHINE_ATTRS = IF_UNLESS | {"name", "address", "env-loader", "ssh-port", "user", "password", "default",
                  "timeout"}
@@ -173,6 +176,29 @@ class Interpreter:
             out.append(value if value is None or "$" not in value
                        else self._resolve(entity, a, scope))
         return out
+
+    def _rosmon_attrs(self, entity: Entity, scope: Scope) -> dict[str, Any]:
+        """rosmon's node attributes as Node fields (only those set, so plans stay equal)."""
+        if not entity.attributes.keys() & ROSMON_NODE_ATTRS:
+            return {}
+        stop, memory, cpu, cores = self._opt(entity, scope, "stop-timeout", "memory-limit",
+                                             "cpu-limit", "enable-coredumps")
+        found: dict[str, Any] = {}
+        for attr, text, field_name, parse in (
+                ("stop-timeout", stop, "stop_timeout", float_attribute),
+                ("memory-limit", memory, "memory_limit", size_attribute),
+                ("cpu-limit", cpu, "cpu_limit", float_attribute),
+                ("enable-coredumps", cores, "enable_coredumps", bool_attribute)):
+            if text is None:
+                continue
+            try:
+                value = parse(text, None, attr)
+            except ValueError as exc:
+                raise self._error(entity, str(exc), attr) from None
+            if isinstance(value, float) and value < 0:
+                raise self._error(entity, f"must not be negative: {text}", attr)
+            found[field_name] = value
+        return found
 
     def _req(self, entity: Entity, scope: Scope, *attrs: str) -> list[str]:
         for a in attrs:
@@ -591,6 +617,7 @@ class Interpreter:
             delay = float_attribute(respawn_delay, 0.0, "respawn_delay")
         except ValueError as exc:
             raise self._error(entity, str(exc)) from None
+        rosmon = self._rosmon_attrs(entity, scope)
 
         remap_scope = scope.child("")
         env_scope = scope.child("")
@@ -640,7 +667,7 @@ class Interpreter:
             raise self._error(entity, "must be one of "
                               + ", ".join(f"'{mode}'" for mode in OUTPUT_MODES), "output")
         node = Node(respawn=respawn_flag, respawn_delay=delay, output=output,
-                    required=required_flag, **common)
+                    required=required_flag, **common, **rosmon)
         full = node.full_name
         if name and full in self._node_names:
             raise self._error(entity, f"duplicate node name [{full}] (first declared at "

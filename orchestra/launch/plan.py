@@ -69,6 +69,11 @@ class Node:
     required: bool = False
     filename: str | None = None
     line: int | None = None
+    # rosmon's extensions (None/0/False: not set; see docs/compat.md)
+    stop_timeout: float | None = None
+    memory_limit: int = 0
+    cpu_limit: float = 0.0
+    enable_coredumps: bool = False
 
     @property
     def full_name(self) -> str:
@@ -92,7 +97,14 @@ class Node:
             "launch_prefix": self.launch_prefix,
             "required": self.required,
             "filename": self.filename,
+            **self._extensions(),
         }
+
+    def _extensions(self) -> dict[str, Any]:
+        """rosmon's attributes, only when set: plans without them stay roslaunch's JSON."""
+        values = {"stop_timeout": self.stop_timeout, "memory_limit": self.memory_limit,
+                  "cpu_limit": self.cpu_limit, "enable_coredumps": self.enable_coredumps}
+        return {k: v for k, v in values.items() if v or (k == "stop_timeout" and v is not None)}
 
 
 @dataclass(frozen=True)

@@ -57,6 +57,25 @@ def bool_attribute(value: str | None, default: bool, label: str) -> bool:
     raise ValueError(f"invalid bool value for {label}: {value}")
 
 
+_SIZE_UNITS = {"": 1, "b": 1, "k": 1000, "kb": 1000, "kib": 1024, "m": 1000**2, "mb": 1000**2,
+               "mib": 1024**2, "g": 1000**3, "gb": 1000**3, "gib": 1024**3}
+
+
+def size_attribute(value: str | None, default: int | None, label: str) -> int | None:
+    """A byte size as rosmon's ``memory-limit`` takes it: ``100000000``, ``15 MB``, ``1GiB``."""
+    if value is None:
+        return default
+    text = value.strip()
+    number = text.rstrip("BbKkMmGgIi ")
+    unit = text[len(number):].strip().lower()
+    try:
+        size = float(number) * _SIZE_UNITS[unit]
+    except (KeyError, ValueError):
+        raise ValueError(f"invalid size for {label}: {value!r} (bytes, or a number with "
+                         "kB/MB/GB/KiB/MiB/GiB)") from None
+    return int(size)
+
+
 def float_attribute(value: str | None, default: float, label: str) -> float:
     if value is None:
         return default

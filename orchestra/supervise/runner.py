@@ -34,7 +34,7 @@ from orchestra.supervise.command import (
     ros_home,
 )
 from orchestra.supervise.output import Screen, prepare_run_log_dir
-from orchestra.supervise.process import OutputMode, ProcessSpec, RestartPolicy
+from orchestra.supervise.process import Limits, OutputMode, ProcessSpec, RestartPolicy
 
 logger = logging.getLogger(__name__)
 
@@ -201,6 +201,9 @@ def build_specs(nodes: list[Node], executables: Mapping[str, str], master_uri: s
         env = dict(base)
         env.update(node_env(node, master_uri))
         sigint, sigterm = options.node_timeouts.get(node.full_name, (None, None))
+        if sigint is None and node.stop_timeout is not None:
+            # rosmon's stop-timeout: SIGINT, then that many seconds, then killed
+            sigint, sigterm = node.stop_timeout, 0.0 if sigterm is None else sigterm
         specs.append(ProcessSpec(
             name=node.full_name, argv=tuple(argv), env=env,
             cwd=node_cwd(node, exe, base),
@@ -209,7 +212,8 @@ def build_specs(nodes: list[Node], executables: Mapping[str, str], master_uri: s
             output=output_mode(node, options), log_name=log_name,
             sigint_timeout=options.sigint_timeout if sigint is None else sigint,
             sigterm_timeout=options.sigterm_timeout if sigterm is None else sigterm,
-            location=str(_location(node)) if node.filename else None))
+            location=str(_location(node)) if node.filename else None,
+            limits=Limits(node.memory_limit, node.cpu_limit, node.enable_coredumps)))
     return specs
 
 
