@@ -32,6 +32,8 @@ COMMANDS: dict[str, str] = {
     "bag": "orchestra.bag.cli:bag",
     "plot": "orchestra.plot.cli:plot",
     "env": "orchestra.ros1.cli:env",
+    "msg": "orchestra.node.msgcli:msg",
+    "srv": "orchestra.node.msgcli:srv",
 }
 
 

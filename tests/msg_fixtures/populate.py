@@ -55,7 +55,7 @@ def _value(slot_type: str, c: Counter, env: dict):
 
 def populate(msg, c: Counter | None = None, env: dict | None = None):
     c = c or Counter()
-    for name, slot_type in zip(msg.__slots__, msg._slot_types):
+    for name, slot_type in zip(msg.__slots__, msg._slot_types, strict=True):
         setattr(msg, name, _value(slot_type, c, env))
     return msg
 
