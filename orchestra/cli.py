@@ -16,15 +16,15 @@ from orchestra.errors import OrchestraError
 
 # name -> "module:attribute" of a click command or group
 COMMANDS: dict[str, str] = {
-    "launch": "orchestra.launch.cli:launch",
+    "launch": "orchestra.app.cli:launch",
     "check": "orchestra.launch.tools_cli:check",
     "convert": "orchestra.launch.tools_cli:convert",
     "pkg": "orchestra.packages.cli:pkg",
     "run": "orchestra.packages.cli:run",
     "create-pkg": "orchestra.packages.cli:create_pkg",
-    "core": "orchestra.master.cli:core",
+    "core": "orchestra.app.cli:core",
     "param": "orchestra.params.cli:param",
-    "status": "orchestra.supervise.cli:status",
+    "status": "orchestra.app.cli:status",
     "node": "orchestra.node.cli:node",
     "topic": "orchestra.node.cli:topic",
     "service": "orchestra.node.cli:service",

@@ -10,6 +10,18 @@ SHARED = REPO.parent / "shared"
 COMPAT = SHARED / "compat"
 
 
+def _plugin_installed() -> bool:
+    """True when orchestra's pytest plugin comes in through its entry point already."""
+    from importlib.metadata import entry_points
+
+    return any(ep.value == "orchestra.app.pytest_plugin"
+               for ep in entry_points(group="pytest11"))
+
+
+# an installation older than the plugin (or none: PYTHONPATH only) still gets the fixture
+pytest_plugins = [] if _plugin_installed() else ["orchestra.app.pytest_plugin"]
+
+
 @pytest.fixture
 def compat_dir() -> Path:
     if not COMPAT.is_dir():

@@ -15,7 +15,7 @@ import pytest
 from orchestra.errors import OrchestraError
 from orchestra.launch.interpreter import Interpreter, LoadOptions, load_launch
 from orchestra.launch.plan import Node
-from orchestra.supervise.runner import RunOptions, build_specs
+from orchestra.supervise.specs import SpecOptions, build_specs
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
 from harness import wait_for  # noqa: E402
@@ -65,7 +65,7 @@ def test_stop_timeout_becomes_the_nodes_sigint_timeout_and_limits_its_spec():
     node = Node("p", "t", "a", stop_timeout=1.0, memory_limit=1 << 20, enable_coredumps=True)
     plain = Node("p", "t", "b")
     specs = build_specs([node, plain], {"/a": "/bin/true", "/b": "/bin/true"},
-                        "http://localhost:1/", "/tmp", RunOptions())
+                        "http://localhost:1/", "/tmp", SpecOptions())
     assert (specs[0].sigint_timeout, specs[0].sigterm_timeout) == (1.0, 0.0)
     assert specs[0].limits.memory == 1 << 20 and specs[0].limits.coredumps
     assert (specs[1].sigint_timeout, specs[1].sigterm_timeout) == (15.0, 2.0)

@@ -22,9 +22,10 @@ from rosout_core.logfile import (  # noqa: E402
     startup_banner,
 )
 
+from orchestra.app.options import RunOptions  # noqa: E402
 from orchestra.launch.plan import Node  # noqa: E402
 from orchestra.supervise.rosout import ROSOUT, core_nodes, resolve_core_executables  # noqa: E402
-from orchestra.supervise.runner import RunOptions, run_specs  # noqa: E402
+from orchestra.supervise.specs import run_specs  # noqa: E402
 
 
 def log_msg(level=2, name="/talker", text="hello", topics=("/rosout", "/chatter"),

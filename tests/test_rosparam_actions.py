@@ -16,13 +16,19 @@ from pathlib import Path
 
 import pytest
 
+from orchestra.app.cli import options_from_cli, serve_plan
 from orchestra.errors import OrchestraError
 from orchestra.launch.interpreter import Interpreter, LoadOptions, load_launch
 from orchestra.launch.plan import ParamAction
 from orchestra.params.dump import dump_yaml
-from orchestra.supervise.cli import run_plan
 
 pytestmark = pytest.mark.timeout(60)
+
+
+def run_plan(plan, options):
+    """What ``orchestra launch`` does with a plan and its flags (click's keyword arguments)."""
+    return serve_plan(plan, options_from_cli(options))
+
 
 OPTS = {"run_id": "rosparam-actions", "status_view": False, "disable_title": True}
 

@@ -1,4 +1,4 @@
-"""``run_plan``: a hand-built LaunchPlan run for real (embedded master on a free port)."""
+"""``serve_plan``: a hand-built LaunchPlan run for real (embedded master on a free port)."""
 from __future__ import annotations
 
 import json
@@ -11,9 +11,9 @@ import time
 
 import pytest
 
+from orchestra.app.cli import options_from_cli, serve_plan
 from orchestra.errors import OrchestraError
 from orchestra.launch.plan import LaunchPlan, Machine, Node
-from orchestra.supervise.cli import run_plan
 from orchestra.supervise.command import node_argv
 from orchestra.supervise.output import Screen
 from orchestra.supervise.process import OutputMode, ProcessSpec, State
@@ -90,6 +90,11 @@ def record(run_env, name):
     return json.loads((run_env["out"] / f"{name}.json").read_text())
 
 
+def run_plan(plan, options):
+    """What ``orchestra launch`` does with a plan and its flags (click's keyword arguments)."""
+    return serve_plan(plan, options_from_cli(options))
+
+
 OPTS = {"run_id": "testrun", "status_view": False, "disable_title": True}
 
 
@@ -157,7 +162,8 @@ def test_required_node_whose_launch_prefix_cannot_start_exits_nonzero(run_env, m
 
 
 def test_node_timeout_option_overrides_stop_timeouts_per_node(run_env):
-    from orchestra.supervise.runner import RunOptions, build_specs
+    from orchestra.app.options import RunOptions
+    from orchestra.supervise.specs import build_specs
 
     nodes = [Node("demo", "probe", "slow"), Node("demo", "probe", "fast")]
     exes = {n.full_name: run_env["probe"] for n in nodes}
@@ -173,7 +179,8 @@ def test_node_timeout_option_overrides_stop_timeouts_per_node(run_env):
     ("screen", {"force_log": True}, OutputMode.LOG),
 ])
 def test_output_mode_from_node_and_screen_log_overrides(output, flags, expected):
-    from orchestra.supervise.runner import RunOptions, output_mode
+    from orchestra.app.options import RunOptions
+    from orchestra.supervise.specs import output_mode
 
     assert output_mode(Node("p", "t", "n", output=output), RunOptions(**flags)) == expected
 
@@ -359,6 +366,6 @@ def test_two_nodes_with_one_name_are_a_user_error(run_env):
 
 
 def test_node_path_puts_orchestras_interpreter_first_when_missing():
-    from orchestra.supervise.runner import path_with_interpreter
+    from orchestra.supervise.command import path_with_interpreter
     assert path_with_interpreter("/usr/bin:/bin", "/venv/bin/python3") == "/venv/bin:/usr/bin:/bin"
     assert path_with_interpreter("/usr/bin:/venv/bin", "/venv/bin/python3") == "/usr/bin:/venv/bin"

@@ -274,7 +274,7 @@ def running_launches(directory: str | None = None) -> list[dict[str, Any]]:
         try:
             found.append({**query(path), "socket": path})
         except (ConnectionRefusedError, FileNotFoundError):
-            pid = name[:-5]
+            pid = name[:-5].split("-")[0]     # <pid>.sock, or <pid>-<n>.sock (API runs)
             if pid.isdigit() and not psutil.pid_exists(int(pid)):
                 try:
                     os.unlink(path)

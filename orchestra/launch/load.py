@@ -1,0 +1,111 @@
+"""From command-line words to a launch plan: ``[PKG] FILE [name:=value ...]``.
+
+Shared by ``orchestra launch``, ``orchestra test`` and the Python API (``launch_file``), so
+a file is found, its args parsed and interpreted the same way everywhere. Imports only the
+standard library at import time; the interpreter is imported when a file is loaded.
+"""
+from __future__ import annotations
+
+import os
+import sys
+from typing import Any
+
+from orchestra.errors import OrchestraError
+
+
+def find_in_package(package: str, filename: str) -> str:
+    """FILE anywhere below PKG's directory (roslaunch's ``roslaunch PKG FILE`` rule)."""
+    from orchestra.packages import find_package
+    root = find_package(package)
+    direct = os.path.join(root, filename)
+    if os.path.isfile(direct):
+        return direct
+    base = os.path.basename(filename)
+    matches = []
+    for dirpath, dirnames, files in os.walk(root, followlinks=True):
+        dirnames[:] = sorted(d for d in dirnames if not d.startswith("."))
+        if base in files:
+            matches.append(os.path.join(dirpath, base))
+    if not matches:
+        raise OrchestraError(f"[{filename}] is neither a launch file in package [{package}] "
+                             "nor a launch file name")
+    if len(matches) > 1:
+        listing = "".join(f"\n  {m}" for m in matches)
+        raise OrchestraError(f"multiple files named [{filename}] in package [{package}]:"
+                             f"{listing}\nname one by its path")
+    return matches[0]
+
+
+def split_words(words: tuple[str, ...]) -> tuple[list[str], dict[str, str]]:
+    """Launch file paths and ``name:=value`` args from the command line words."""
+    from orchestra.names import load_mappings
+    positional = [w for w in words if ":=" not in w]
+    args = load_mappings([w for w in words if ":=" in w])
+    if not positional:
+        raise OrchestraError("give a launch file: [PKG] FILE [name:=value ...]")
+    first = positional[0]
+    if first == "-" or os.path.isfile(first) or len(positional) != 2 \
+            or first.endswith((".launch", ".xml", ".yaml", ".yml")):
+        files = positional
+    else:
+        files = [find_in_package(first, positional[1])]
+    return files, args
+
+
+def interpret(files: list[str], args: dict[str, str], *, no_exec: bool, roscore: bool):
+    from orchestra.launch.interpreter import Interpreter, LoadOptions
+    interp = Interpreter(LoadOptions(args=args, no_exec=no_exec, roscore=roscore))
+    for path in files:
+        if path == "-":
+            from orchestra.launch.xml import parse_string
+            interp.load_entity(parse_string(sys.stdin.read(), "<stdin>"), "<stdin>")
+        else:
+            missing = not os.path.isfile(path)
+            if missing:
+                raise OrchestraError(f"launch file not found: {path}")
+            interp.load_file(os.path.abspath(path))
+    return interp
+
+
+def find_node(plan: Any, name: str) -> Any:
+    from orchestra.names import canonicalize, make_global_ns
+    wanted = canonicalize(name if name.startswith("/") else make_global_ns(
+        os.environ.get("ROS_NAMESPACE", "/")) + name)
+    found = [n for n in (*plan.nodes, *plan.tests) if n.name and n.full_name == wanted]
+    if not found:
+        names = "".join(f"\n * {n.full_name}" for n in (*plan.nodes, *plan.tests) if n.name)
+        raise OrchestraError(f"cannot find node named [{wanted}]. Node names are:{names}")
+    if len(found) > 1:
+        raise OrchestraError(f"multiple nodes named [{wanted}]")
+    return found[0]
+
+
+def ros_args_text(paths: list[str], args: dict[str, str]) -> str:
+    from orchestra.launch.interpreter import declared_args, parse_launch_file
+    declared = []
+    for path in paths:
+        if path == "-":
+            from orchestra.launch.xml import parse_string
+            declared += declared_args(parse_string(sys.stdin.read(), "<stdin>"), "<stdin>", args)
+        else:
+            declared += declared_args(parse_launch_file(path), path, args)
+    required = [a for a in declared if not a.default]
+    optional = [a for a in declared if a.default]
+    if not required and not optional:
+        return "No arguments."
+    lines = []
+    if required:
+        lines.append("Required Arguments:")
+        lines += [f"  {a.name}: {a.doc or 'undocumented'}" for a in sorted(required,
+                                                                            key=lambda a: a.name)]
+    if optional:
+        lines.append("Optional Arguments:")
+        lines += [f"  {a.name} (default \"{a.default}\"): {a.doc or 'undocumented'}"
+                  for a in sorted(optional, key=lambda a: a.name)]
+    return "\n".join(lines)
+
+
+def load_plan(files: list[str], args: dict[str, str], *, no_exec: bool = False,
+              roscore: bool = True) -> Any:
+    """The plan of ``files`` with ``args`` (roscore.xml's params first when ``roscore``)."""
+    return interpret(files, args, no_exec=no_exec, roscore=roscore).plan()
