@@ -420,6 +420,11 @@ def _at_exit() -> None:
 
 # --- the rospy-style functions -----------------------------------------------------------------
 
+def is_initialized() -> bool:
+    """Whether ``init_node`` has made this process a node (rospy.core.is_initialized)."""
+    return _runtime is not None
+
+
 def get_name() -> str:
     return get_runtime().name
 
@@ -604,7 +609,21 @@ def _setup_logging(level: int | None) -> None:
         handler.addFilter(_explicitly_lowered)
         library.addHandler(handler)
     _user_log.propagate = False
-    _user_log.setLevel(level if level is not None and level >= 10 else logging.INFO)
+    _user_log.setLevel(_python_level(level))
+
+
+#: rospy's level constants (``init_node(log_level=rospy.DEBUG)``), as rosgraph_msgs/Log has them
+DEBUG, INFO, WARN, ERROR, FATAL = 1, 2, 4, 8, 16
+_FROM_ROSPY = {DEBUG: logging.DEBUG, INFO: logging.INFO, WARN: logging.WARNING,
+               ERROR: logging.ERROR, FATAL: logging.CRITICAL}
+
+
+def _python_level(level: int | None) -> int:
+    """``init_node``'s ``log_level``: one of rospy's constants above or a ``logging`` level
+    (10 and up); anything else is INFO, rospy's default."""
+    if level in _FROM_ROSPY:
+        return _FROM_ROSPY[level]
+    return level if level is not None and level >= 10 else logging.INFO
 
 
 def _offer_logger_services() -> list:
@@ -631,19 +650,26 @@ def _make_rosout():
         return None
 
 
-def _log(level: int, msg: Any, args: tuple) -> None:
+def _log(level: int, msg: Any, args: tuple, logger_name: str | None = None,
+         depth: int = 2) -> None:
+    """Print and publish one message; ``depth`` frames up is the user's call (file, line
+    and function of the /rosout record). ``logger_name`` logs through the child logger
+    ``rosout.<name>`` (rospy's ``logger_name=`` keyword), so its level can be set apart."""
     # below the level of the logger "rosout" (init_node's log_level, or ~set_logger_level
     # since) a message is neither printed nor published, as in rospy
-    if not _user_log.isEnabledFor(level):
+    logger = _user_log.getChild(logger_name) if logger_name else _user_log
+    if not logger.isEnabledFor(level):
         return
     text = str(msg) % args if args else str(msg)
-    _user_log.log(level, text)
+    logger.log(level, text)
     rt = _runtime
     pub = getattr(rt, "rosout", None) if rt is not None else None
     if pub is None or rt.is_shutdown():
         return
     frame = inspect.currentframe()
-    caller = frame.f_back.f_back if frame and frame.f_back else None
+    caller = frame
+    for _ in range(depth):
+        caller = caller.f_back if caller is not None else None
     try:
         from orchestra.node.rostime import Time
         m = pub.data_class(level=_LEVELS[level][1], name=rt.name, msg=text,
@@ -659,41 +685,143 @@ def _log(level: int, msg: Any, args: tuple) -> None:
         del frame, caller
 
 
-def logdebug(msg: Any, *args: Any) -> None:
-    _log(logging.DEBUG, msg, args)
+def logdebug(msg: Any, *args: Any, logger_name: str | None = None) -> None:
+    _log(logging.DEBUG, msg, args, logger_name)
 
 
-def loginfo(msg: Any, *args: Any) -> None:
-    _log(logging.INFO, msg, args)
+def loginfo(msg: Any, *args: Any, logger_name: str | None = None) -> None:
+    _log(logging.INFO, msg, args, logger_name)
 
 
-def logwarn(msg: Any, *args: Any) -> None:
-    _log(logging.WARNING, msg, args)
+def logwarn(msg: Any, *args: Any, logger_name: str | None = None) -> None:
+    _log(logging.WARNING, msg, args, logger_name)
 
 
-def logerr(msg: Any, *args: Any) -> None:
-    _log(logging.ERROR, msg, args)
+def logerr(msg: Any, *args: Any, logger_name: str | None = None) -> None:
+    _log(logging.ERROR, msg, args, logger_name)
 
 
-def logfatal(msg: Any, *args: Any) -> None:
-    _log(logging.CRITICAL, msg, args)
+def logfatal(msg: Any, *args: Any, logger_name: str | None = None) -> None:
+    _log(logging.CRITICAL, msg, args, logger_name)
 
 
-_throttle_state: dict[tuple, float] = {}
+# --- the rate-limited forms: each call site (file, line) keeps its own state, as in rospy;
+# the helpers below are always called from a public log function, so the user's frame is
+# three up from them and the /rosout record names the user's line (depth=3)
+
+_site_state: dict[tuple, Any] = {}
+_site_lock = threading.Lock()
 
 
-def loginfo_throttle(period: float, msg: Any, *args: Any) -> None:
-    _throttled(logging.INFO, period, msg, args)
+def _call_site() -> tuple:
+    frame = inspect.currentframe().f_back.f_back.f_back
+    try:
+        return (frame.f_code.co_filename, frame.f_lineno)
+    finally:
+        del frame
 
 
-def logwarn_throttle(period: float, msg: Any, *args: Any) -> None:
-    _throttled(logging.WARNING, period, msg, args)
+def _throttled(level: int, period: float, msg: Any, args: tuple,
+               logger_name: str | None) -> None:
+    """At most one message per ``period`` seconds (ROS time, as rospy) from this call site."""
+    key = ("throttle",) + _call_site()
+    now = rostime.get_time()
+    with _site_lock:
+        last = _site_state.get(key)
+        # a clock that jumped back (sim time reset) starts the period again
+        due = last is None or now - last >= period or now < last
+        if due:
+            _site_state[key] = now
+    if due:
+        _log(level, msg, args, logger_name, depth=3)
 
 
-def _throttled(level: int, period: float, msg: Any, args: tuple) -> None:
-    frame = inspect.currentframe().f_back.f_back
-    key = (frame.f_code.co_filename, frame.f_lineno)
-    now = time.monotonic()
-    if now - _throttle_state.get(key, -1e18) >= period:
-        _throttle_state[key] = now
-        _log(level, msg, args)
+def _throttled_identical(level: int, period: float, msg: Any, args: tuple,
+                         logger_name: str | None) -> None:
+    """A message different from the call site's previous one at once; a repeat of it only
+    when ``period`` seconds have passed since it was last logged."""
+    key = ("identical",) + _call_site()
+    text = str(msg) % args if args else str(msg)
+    now = rostime.get_time()
+    with _site_lock:
+        last = _site_state.get(key)
+        due = (last is None or last[1] != text or now - last[0] >= period or now < last[0])
+        if due:
+            _site_state[key] = (now, text)
+    if due:
+        _log(level, text, (), logger_name, depth=3)
+
+
+def _once(level: int, msg: Any, args: tuple, logger_name: str | None) -> None:
+    """Only the first message from this call site."""
+    key = ("once",) + _call_site()
+    with _site_lock:
+        due = key not in _site_state
+        _site_state[key] = True
+    if due:
+        _log(level, msg, args, logger_name, depth=3)
+
+
+def logdebug_throttle(period: float, msg: Any, *args: Any, logger_name: str | None = None) -> None:
+    _throttled(logging.DEBUG, period, msg, args, logger_name)
+
+
+def loginfo_throttle(period: float, msg: Any, *args: Any, logger_name: str | None = None) -> None:
+    _throttled(logging.INFO, period, msg, args, logger_name)
+
+
+def logwarn_throttle(period: float, msg: Any, *args: Any, logger_name: str | None = None) -> None:
+    _throttled(logging.WARNING, period, msg, args, logger_name)
+
+
+def logerr_throttle(period: float, msg: Any, *args: Any, logger_name: str | None = None) -> None:
+    _throttled(logging.ERROR, period, msg, args, logger_name)
+
+
+def logfatal_throttle(period: float, msg: Any, *args: Any, logger_name: str | None = None) -> None:
+    _throttled(logging.CRITICAL, period, msg, args, logger_name)
+
+
+def logdebug_throttle_identical(period: float, msg: Any, *args: Any,
+                                logger_name: str | None = None) -> None:
+    _throttled_identical(logging.DEBUG, period, msg, args, logger_name)
+
+
+def loginfo_throttle_identical(period: float, msg: Any, *args: Any,
+                               logger_name: str | None = None) -> None:
+    _throttled_identical(logging.INFO, period, msg, args, logger_name)
+
+
+def logwarn_throttle_identical(period: float, msg: Any, *args: Any,
+                               logger_name: str | None = None) -> None:
+    _throttled_identical(logging.WARNING, period, msg, args, logger_name)
+
+
+def logerr_throttle_identical(period: float, msg: Any, *args: Any,
+                              logger_name: str | None = None) -> None:
+    _throttled_identical(logging.ERROR, period, msg, args, logger_name)
+
+
+def logfatal_throttle_identical(period: float, msg: Any, *args: Any,
+                                logger_name: str | None = None) -> None:
+    _throttled_identical(logging.CRITICAL, period, msg, args, logger_name)
+
+
+def logdebug_once(msg: Any, *args: Any, logger_name: str | None = None) -> None:
+    _once(logging.DEBUG, msg, args, logger_name)
+
+
+def loginfo_once(msg: Any, *args: Any, logger_name: str | None = None) -> None:
+    _once(logging.INFO, msg, args, logger_name)
+
+
+def logwarn_once(msg: Any, *args: Any, logger_name: str | None = None) -> None:
+    _once(logging.WARNING, msg, args, logger_name)
+
+
+def logerr_once(msg: Any, *args: Any, logger_name: str | None = None) -> None:
+    _once(logging.ERROR, msg, args, logger_name)
+
+
+def logfatal_once(msg: Any, *args: Any, logger_name: str | None = None) -> None:
+    _once(logging.CRITICAL, msg, args, logger_name)

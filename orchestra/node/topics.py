@@ -130,6 +130,10 @@ class Publication:
         self.seq = 0
         self.messages = 0
         self.closed = False
+        #: rospy SubscribeListener-style objects: ``peer_subscribe(topic, publish_to_all,
+        #: publish_to_this_peer)`` when a subscriber connects, ``peer_unsubscribe(topic,
+        #: remaining)`` when one leaves (e.g. to greet each new subscriber with a message)
+        self.listeners: list[Any] = []
 
     @property
     def type(self) -> str:
@@ -165,13 +169,34 @@ class Publication:
                 conn.queue.append(self.latched)
             self.connections.append(conn)
         conn.thread.start()
+        for listener in list(self.listeners):
+            self._notify(listener.peer_subscribe, self.topic, self._publish_any,
+                         lambda msg, conn=conn: conn.enqueue(self._coerce(msg).serialize_bytes()))
         return conn
+
+    def _coerce(self, msg: Any) -> Message:
+        return msg if isinstance(msg, Message) else self.msg_class(msg)
+
+    def _publish_any(self, msg: Any) -> None:
+        self.publish(self._coerce(msg))
+
+    @staticmethod
+    def _notify(method: Callable, *args: Any) -> None:
+        try:
+            method(*args)
+        except Exception:
+            log.exception("error in subscriber listener %r", method)
 
     def remove_connection(self, conn: OutConnection) -> None:
         with self.lock:
-            if conn in self.connections:
+            known = conn in self.connections
+            if known:
                 self.connections.remove(conn)
+            remaining = len(self.connections)
         conn.close()
+        if known:
+            for listener in list(self.listeners):
+                self._notify(listener.peer_unsubscribe, self.topic, remaining)
 
     def prune(self) -> None:
         """Drop connections whose subscriber has gone away."""
@@ -197,7 +222,7 @@ class Publisher:
     """Publish messages of ``msg_class`` on ``topic`` (name resolved like rospy)."""
 
     def __init__(self, topic: str, msg_class: type[Message], queue_size: int | None = 10,
-                 latch: bool = False, **_ignored: Any):
+                 latch: bool = False, subscriber_listener: Any = None, **_ignored: Any):
         from orchestra.node.runtime import get_runtime
 
         if not (isinstance(msg_class, type) and issubclass(msg_class, Message)):
@@ -207,7 +232,8 @@ class Publisher:
         self.data_class = msg_class
         self.type = msg_class._type
         self.md5sum = msg_class._md5sum
-        self._impl = self._rt.topics.acquire_publication(self.name, msg_class, latch, queue_size)
+        self._impl = self._rt.topics.acquire_publication(self.name, msg_class, latch, queue_size,
+                                                         subscriber_listener)
         self._done = False
 
     def publish(self, *args, **kwargs) -> None:
@@ -523,7 +549,7 @@ class TopicManager:
         self.subscriptions: dict[str, Subscription] = {}
 
     def acquire_publication(self, topic: str, msg_class: type[Message], latch: bool,
-                            queue_size: int | None) -> Publication:
+                            queue_size: int | None, listener: Any = None) -> Publication:
         with self.lock:
             pub = self.publications.get(topic)
             if pub is not None:
@@ -532,9 +558,13 @@ class TopicManager:
                                        f"cannot also publish {msg_class._type}")
                 pub.latch = pub.latch or latch
                 pub.handles += 1
+                if listener is not None:
+                    pub.listeners.append(listener)
                 return pub
             pub = Publication(self.rt, topic, msg_class, latch, queue_size)
             pub.handles = 1
+            if listener is not None:
+                pub.listeners.append(listener)
             self.publications[topic] = pub
         self.rt.master_register("registerPublisher", topic, msg_class._type)
         return pub
