@@ -50,7 +50,14 @@ for _level in ("debug", "info", "warn", "err", "fatal"):
 __all__ = sorted(_WHERE)
 
 
+#: rospy's submodules that code reaches as attributes after a bare ``import rospy``
+_SUBMODULES = frozenset({"client", "core", "exceptions", "msg", "msproxy", "names", "rostime",
+                         "service", "timer", "topics"})
+
+
 def __getattr__(name: str) -> Any:
+    if name in _SUBMODULES:
+        return importlib.import_module(f"{__name__}.{name}")
     module = _WHERE.get(name)
     if module is None:
         raise AttributeError(f"module 'rospy' has no attribute {name!r}")
@@ -60,4 +67,4 @@ def __getattr__(name: str) -> Any:
 
 
 def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_WHERE))
+    return sorted(set(globals()) | set(_WHERE) | _SUBMODULES)

@@ -18,10 +18,14 @@ from orchestra.node.tcpros import parse_rosrpc_uri
 #: rospy's deprecated name for loginfo
 logout = loginfo
 
-__all__ = ["get_node_uri", "get_ros_root", "is_initialized", "is_shutdown", "logout",
-           "parse_rosrpc_uri", "signal_shutdown"] + [
-    f"log{level}{form}" for level in ("debug", "info", "warn", "err", "fatal")
-    for form in ("", "_throttle", "_throttle_identical", "_once")]
+__all__ = [
+    "get_node_uri", "get_ros_root", "is_initialized", "is_shutdown", "is_shutdown_requested",
+    "logdebug", "logdebug_once", "logdebug_throttle", "logdebug_throttle_identical", "logerr",
+    "logerr_once", "logerr_throttle", "logerr_throttle_identical", "logfatal", "logfatal_once",
+    "logfatal_throttle", "logfatal_throttle_identical", "loginfo", "loginfo_once",
+    "loginfo_throttle", "loginfo_throttle_identical", "logout", "logwarn", "logwarn_once",
+    "logwarn_throttle", "logwarn_throttle_identical", "parse_rosrpc_uri", "signal_shutdown",
+]
 
 
 def is_shutdown_requested() -> bool:

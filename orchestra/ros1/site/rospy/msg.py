@@ -3,7 +3,7 @@ from typing import Any
 
 from orchestra.node.msg import AnyMsg, get_message_class
 
-__all__ = ["AnyMsg", "Header"]
+__all__ = ["AnyMsg", "Header"]  # noqa: F822 - Header is made by __getattr__
 
 
 def __getattr__(name: str) -> Any:
