@@ -70,7 +70,8 @@ from orchestra.node.timer import Timer, TimerEvent
 from orchestra.node.topics import Publisher, Subscriber
 
 __all__ = [
-    "AnyMsg", "DEBUG", "Duration", "ERROR", "FATAL", "INFO", "WARN", "Publisher", "ROSException", "ROSInitException",
+    "AnyMsg", "DEBUG", "Duration", "ERROR", "FATAL", "INFO", "WARN", "Publisher", "ROSException",
+    "ROSInitException",
     "ROSInterruptException", "ROSTimeMovedBackwardsException", "Rate", "SerializationError",
     "Service", "ServiceException",
     "ServiceProxy", "Subscriber", "Time", "Timer", "TimerEvent", "TransportException", "delete_param",

@@ -3,7 +3,8 @@ the caller id filled in and the ``[code, msg, value]`` reply unwrapped: the valu
 ``MasterFailure`` (code 0) / ``MasterError`` (code -1), as rosgraph does."""
 from __future__ import annotations
 
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 from orchestra.node.masterapi import MasterError as _Unreachable
 from orchestra.node.masterapi import raw_call

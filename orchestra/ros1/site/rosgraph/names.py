@@ -3,11 +3,20 @@ from __future__ import annotations
 
 import os
 import sys
-from typing import Mapping
+from collections.abc import Mapping
 
-from orchestra.names import (anonymous_name, canonicalize, is_global, is_legal_base_name,
-                             is_legal_name, is_private, load_mappings, make_global_ns,
-                             namespace, ns_join)
+from orchestra.names import (
+    anonymous_name,
+    canonicalize,
+    is_global,
+    is_legal_base_name,
+    is_legal_name,
+    is_private,
+    load_mappings,
+    make_global_ns,
+    namespace,
+    ns_join,
+)
 from orchestra.names import resolve_name as _resolve
 from orchestra.node.names import parse_args
 

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import os
 import sys
-from typing import Mapping
+from collections.abc import Mapping
 
 from orchestra.node.names import parse_args
 from orchestra.node.runtime import DEFAULT_MASTER_URI

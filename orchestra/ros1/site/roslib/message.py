@@ -4,7 +4,8 @@ from __future__ import annotations
 from typing import Any
 
 from orchestra.node.exceptions import ROSException
-from orchestra.node.msg import Message, get_message_class as _message_class
+from orchestra.node.msg import Message
+from orchestra.node.msg import get_message_class as _message_class
 from orchestra.node.msg import get_service_class as _service_class
 
 __all__ = ["Message", "get_message_class", "get_service_class"]

@@ -3,8 +3,13 @@ from __future__ import annotations
 
 import os
 
-from orchestra.packages import (AmbiguousExecutable, ExecutableNotFound, PackageNotFound,
-                                find_executable, find_package)
+from orchestra.packages import (
+    AmbiguousExecutable,
+    ExecutableNotFound,
+    PackageNotFound,
+    find_executable,
+    find_package,
+)
 from orchestra.packages.index import PackageIndex
 
 __all__ = ["InvalidROSPkgException", "ROSPkgException", "find_node", "get_pkg_dir"]

@@ -3,7 +3,7 @@ dependency graph (the same answers as ``orchestra pkg find|list|deps``)."""
 from __future__ import annotations
 
 import os
-from typing import Mapping
+from collections.abc import Mapping
 
 from orchestra.packages import PackageNotFound, get_index
 from orchestra.packages.deps import all_packages_graph, build_graph

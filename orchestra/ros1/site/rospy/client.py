@@ -4,13 +4,29 @@ from __future__ import annotations
 import os
 import threading
 
-from orchestra.node.runtime import (DEBUG, DEFAULT_MASTER_URI, ERROR, FATAL, INFO, WARN,
-                                    delete_param, get_param, get_param_cached,
-                                    get_param_names, get_published_topics, get_runtime,
-                                    has_param, is_initialized, myargv,
-                                    on_shutdown, search_param, set_param, spin,
-                                    wait_for_message)
 from orchestra.node import runtime as _runtime
+from orchestra.node.runtime import (
+    DEBUG,
+    DEFAULT_MASTER_URI,
+    ERROR,
+    FATAL,
+    INFO,
+    WARN,
+    delete_param,
+    get_param,
+    get_param_cached,
+    get_param_names,
+    get_published_topics,
+    get_runtime,
+    has_param,
+    is_initialized,
+    myargv,
+    on_shutdown,
+    search_param,
+    set_param,
+    spin,
+    wait_for_message,
+)
 from rospy import topics as _topics
 from rospy.msproxy import MasterProxy
 

@@ -4,15 +4,32 @@ from __future__ import annotations
 import os
 
 from orchestra.node.exceptions import ROSException
-from orchestra.node.runtime import (get_node_uri, is_initialized, is_shutdown, logdebug,
-                                    logdebug_once, logdebug_throttle,
-                                    logdebug_throttle_identical, logerr, logerr_once,
-                                    logerr_throttle, logerr_throttle_identical, logfatal,
-                                    logfatal_once, logfatal_throttle,
-                                    logfatal_throttle_identical, loginfo, loginfo_once,
-                                    loginfo_throttle, loginfo_throttle_identical, logwarn,
-                                    logwarn_once, logwarn_throttle, logwarn_throttle_identical,
-                                    signal_shutdown)
+from orchestra.node.runtime import (
+    get_node_uri,
+    is_initialized,
+    is_shutdown,
+    logdebug,
+    logdebug_once,
+    logdebug_throttle,
+    logdebug_throttle_identical,
+    logerr,
+    logerr_once,
+    logerr_throttle,
+    logerr_throttle_identical,
+    logfatal,
+    logfatal_once,
+    logfatal_throttle,
+    logfatal_throttle_identical,
+    loginfo,
+    loginfo_once,
+    loginfo_throttle,
+    loginfo_throttle_identical,
+    logwarn,
+    logwarn_once,
+    logwarn_throttle,
+    logwarn_throttle_identical,
+    signal_shutdown,
+)
 from orchestra.node.tcpros import parse_rosrpc_uri
 
 #: rospy's deprecated name for loginfo

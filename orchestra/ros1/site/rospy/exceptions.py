@@ -1,8 +1,13 @@
 """rospy.exceptions: orchestra's exception classes (what its runtime raises), under rospy's
 names. The three rospy has and orchestra's runtime never raises are subclasses, so
 ``except`` clauses written for them are valid and catch what rospy's documentation says."""
-from orchestra.node.exceptions import (ROSException, ROSInitException, ROSInterruptException,
-                                       ROSTimeMovedBackwardsException, TransportException)
+from orchestra.node.exceptions import (
+    ROSException,
+    ROSInitException,
+    ROSInterruptException,
+    ROSTimeMovedBackwardsException,
+    TransportException,
+)
 from orchestra.node.exceptions import SerializationError as ROSSerializationException
 
 

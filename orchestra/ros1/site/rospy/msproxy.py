@@ -4,7 +4,8 @@ Attribute calls send this node's caller id first and return the raw ``[code, msg
 triple, as rospy's proxy does; item access is the parameter server with Python semantics."""
 from __future__ import annotations
 
-from typing import Any, Callable, Iterator
+from collections.abc import Callable, Iterator
+from typing import Any
 
 from orchestra.node import runtime
 from orchestra.node.exceptions import ROSException

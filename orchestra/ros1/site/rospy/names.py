@@ -2,8 +2,7 @@
 from __future__ import annotations
 
 from orchestra import names as _graph_names
-from orchestra.node.runtime import (get_caller_id, get_name, get_namespace, get_runtime,
-                                    resolve_name)
+from orchestra.node.runtime import get_caller_id, get_name, get_namespace, get_runtime, resolve_name
 
 __all__ = ["canonicalize_name", "get_caller_id", "get_mappings", "get_name", "get_namespace",
            "get_resolved_mappings", "remap_name", "resolve_name", "scoped_name"]

@@ -3,7 +3,8 @@ signatures (``Service(..., error_handler=...)``)."""
 from __future__ import annotations
 
 import sys
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 from orchestra.node import services as _services
 from orchestra.node.exceptions import ServiceException

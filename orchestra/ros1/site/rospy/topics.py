@@ -10,7 +10,8 @@ is rospy's error.
 from __future__ import annotations
 
 import threading
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 from orchestra.node import runtime as _runtime
 from orchestra.node import topics as _topics

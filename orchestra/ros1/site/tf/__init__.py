@@ -16,8 +16,12 @@ from typing import Any
 from orchestra.tf import broadcaster as _broadcaster
 from orchestra.tf import listener as _listener
 from orchestra.tf import transformations as _tfm
-from orchestra.tf.buffer import ConnectivityException, ExtrapolationException, LookupException
-from orchestra.tf.buffer import TransformBuffer
+from orchestra.tf.buffer import (
+    ConnectivityException,
+    ExtrapolationException,
+    LookupException,
+    TransformBuffer,
+)
 from orchestra.tf.buffer import TransformException as Exception  # noqa: A001 - tf's name
 from orchestra.tf.convert import to_sec, transform_from_msg
 

@@ -10,7 +10,8 @@ come from orchestra.tf.transformations (one place for the quaternion algebra).
 from __future__ import annotations
 
 import math
-from typing import Any, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 import numpy
 
