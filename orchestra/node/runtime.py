@@ -714,9 +714,11 @@ _site_lock = threading.Lock()
 
 
 def _call_site() -> tuple:
-    frame = inspect.currentframe().f_back.f_back.f_back
+    frame = inspect.currentframe()
+    for _ in range(3):
+        frame = frame.f_back if frame is not None else None
     try:
-        return (frame.f_code.co_filename, frame.f_lineno)
+        return (frame.f_code.co_filename, frame.f_lineno) if frame is not None else ("?", 0)
     finally:
         del frame
 

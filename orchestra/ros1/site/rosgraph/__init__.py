@@ -5,8 +5,9 @@ from __future__ import annotations
 import sys
 
 from orchestra.node.names import is_remap_arg
-from rosgraph.masterapi import Master, MasterError, MasterException, MasterFailure, is_online
-from rosgraph.rosenv import ROS_MASTER_URI, get_master_uri
+
+from .masterapi import Master, MasterError, MasterException, MasterFailure, is_online
+from .rosenv import ROS_MASTER_URI, get_master_uri
 
 __all__ = ["Master", "MasterError", "MasterException", "MasterFailure", "ROS_MASTER_URI",
            "get_master_uri", "is_master_online", "myargv"]

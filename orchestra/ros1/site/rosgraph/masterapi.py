@@ -8,7 +8,8 @@ from typing import Any
 
 from orchestra.node.masterapi import MasterError as _Unreachable
 from orchestra.node.masterapi import raw_call
-from rosgraph.rosenv import get_master_uri
+
+from .rosenv import get_master_uri
 
 __all__ = ["Master", "MasterError", "MasterException", "MasterFailure", "is_online"]
 

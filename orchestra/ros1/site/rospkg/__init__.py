@@ -2,6 +2,7 @@
 dependency graph (the same answers as ``orchestra pkg find|list|deps``)."""
 from __future__ import annotations
 
+import builtins
 import os
 from collections.abc import Mapping
 
@@ -26,7 +27,7 @@ class RosPack:
     def __init__(self, ros_paths: list[str] | None = None):
         self.ros_paths = ros_paths
 
-    def list(self) -> list[str]:
+    def list(self) -> builtins.list[str]:
         return get_index().names()
 
     def get_path(self, name: str) -> str:
@@ -38,13 +39,13 @@ class RosPack:
     def _known(self, name: str) -> None:
         self.get_path(name)
 
-    def get_depends(self, name: str, implicit: bool = True) -> list[str]:
+    def get_depends(self, name: str, implicit: bool = True) -> builtins.list[str]:
         """What ``name`` depends on: all of it (``implicit``) or only its direct entries."""
         self._known(name)
         graph = build_graph([name])
         return graph.transitive(name) if implicit else graph.direct(name)
 
-    def get_depends_on(self, name: str, implicit: bool = True) -> list[str]:
+    def get_depends_on(self, name: str, implicit: bool = True) -> builtins.list[str]:
         """The packages that depend on ``name`` (directly unless ``implicit``)."""
         self._known(name)
         graph = all_packages_graph()

@@ -27,8 +27,9 @@ from orchestra.node.runtime import (
     spin,
     wait_for_message,
 )
-from rospy import topics as _topics
-from rospy.msproxy import MasterProxy
+
+from . import topics as _topics
+from .msproxy import MasterProxy
 
 __all__ = ["DEBUG", "ERROR", "FATAL", "INFO", "WARN", "delete_param", "get_master",
            "get_param", "get_param_cached", "get_param_names", "get_published_topics",

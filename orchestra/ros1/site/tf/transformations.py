@@ -120,7 +120,7 @@ def is_same_transform(matrix0: Any, matrix1: Any) -> bool:
 
 # --- quaternions --------------------------------------------------------------------------------
 
-def quaternion_matrix(quaternion: Sequence[float]) -> numpy.ndarray:
+def quaternion_matrix(quaternion: Any) -> numpy.ndarray:
     """The 4x4 rotation matrix of ``[x, y, z, w]`` (normalised first; zero -> identity)."""
     q = numpy.array(quaternion[:4], dtype=numpy.float64, copy=True)
     n = numpy.dot(q, q)
