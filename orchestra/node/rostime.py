@@ -34,8 +34,19 @@ class _TimeBase:
         self.secs, self.nsecs = _normalise(secs, nsecs)
 
     @classmethod
-    def from_sec(cls, seconds: float):
-        return cls(float(seconds))
+    def from_sec(cls, float_secs: float):
+        return cls(float(float_secs))
+
+    #: genpy's older name
+    from_seconds = from_sec
+
+    def set(self, secs: int, nsecs: int) -> None:
+        """Both fields at once (genpy's ``set``), normalised."""
+        self.secs, self.nsecs = _normalise(secs, nsecs)
+
+    def canon(self):
+        """genpy's normalisation; values here are always normal, so this is ``self``."""
+        return self
 
     @classmethod
     def from_nsec(cls, nanoseconds: int):
@@ -46,6 +57,10 @@ class _TimeBase:
 
     def to_nsec(self) -> int:
         return self.secs * 1_000_000_000 + self.nsecs
+
+    #: genpy's other name for to_sec
+    def to_time(self) -> float:
+        return self.to_sec()
 
     def is_zero(self) -> bool:
         return self.secs == 0 and self.nsecs == 0

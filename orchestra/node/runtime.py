@@ -471,8 +471,8 @@ def signal_shutdown(reason: str) -> None:
         _runtime.signal_shutdown(reason)
 
 
-def on_shutdown(callback: Callable[..., Any]) -> None:
-    get_runtime().add_hook(callback)
+def on_shutdown(h: Callable[..., Any]) -> None:
+    get_runtime().add_hook(h)
 
 
 def spin() -> None:
@@ -488,41 +488,43 @@ def spin() -> None:
 
 # params -------------------------------------------------------------------------------------------
 
-def get_param(name: str, default: Any = _UNSET) -> Any:
+# (parameter names are rospy's: callers may pass them as keywords)
+
+def get_param(param_name: str, default: Any = _UNSET) -> Any:
     rt = get_runtime()
-    key = rt.resolve_name(name)
+    key = rt.resolve_name(param_name)
     code, msg, value = rt.master.raw("getParam", key)
     if code != 1:
         if default is _UNSET:
-            raise KeyError(name)
+            raise KeyError(param_name)
         return default
     return value
 
 
-def get_param_cached(name: str, default: Any = _UNSET) -> Any:
-    return get_param(name, default)
+def get_param_cached(param_name: str, default: Any = _UNSET) -> Any:
+    return get_param(param_name, default)
 
 
-def set_param(name: str, value: Any) -> None:
+def set_param(param_name: str, param_value: Any) -> None:
     rt = get_runtime()
-    rt.master.call("setParam", rt.resolve_name(name), value)
+    rt.master.call("setParam", rt.resolve_name(param_name), param_value)
 
 
-def has_param(name: str) -> bool:
+def has_param(param_name: str) -> bool:
     rt = get_runtime()
-    return bool(rt.master.call("hasParam", rt.resolve_name(name)))
+    return bool(rt.master.call("hasParam", rt.resolve_name(param_name)))
 
 
-def delete_param(name: str) -> None:
+def delete_param(param_name: str) -> None:
     rt = get_runtime()
-    code, msg, _ = rt.master.raw("deleteParam", rt.resolve_name(name))
+    code, msg, _ = rt.master.raw("deleteParam", rt.resolve_name(param_name))
     if code != 1:
-        raise KeyError(name)
+        raise KeyError(param_name)
 
 
-def search_param(name: str) -> str | None:
+def search_param(param_name: str) -> str | None:
     rt = get_runtime()
-    code, msg, value = rt.master.raw("searchParam", name)
+    code, msg, value = rt.master.raw("searchParam", param_name)
     return value if code == 1 and value else None
 
 
@@ -650,18 +652,21 @@ def _make_rosout():
         return None
 
 
-def _log(level: int, msg: Any, args: tuple, logger_name: str | None = None,
+def _log(level: int, msg: Any, args: tuple, kwargs: dict | None = None,
          depth: int = 2) -> None:
     """Print and publish one message; ``depth`` frames up is the user's call (file, line
-    and function of the /rosout record). ``logger_name`` logs through the child logger
-    ``rosout.<name>`` (rospy's ``logger_name=`` keyword), so its level can be set apart."""
+    and function of the /rosout record). ``kwargs`` are rospy's: ``logger_name`` logs
+    through the child logger ``rosout.<name>`` (so its level can be set apart); the rest
+    (``exc_info``, ``stack_info``, ``extra``) go to Python's logging for the console."""
+    kwargs = dict(kwargs or {})
+    logger_name = kwargs.pop("logger_name", None)
     # below the level of the logger "rosout" (init_node's log_level, or ~set_logger_level
     # since) a message is neither printed nor published, as in rospy
     logger = _user_log.getChild(logger_name) if logger_name else _user_log
     if not logger.isEnabledFor(level):
         return
     text = str(msg) % args if args else str(msg)
-    logger.log(level, text)
+    logger.log(level, text, **kwargs)
     rt = _runtime
     pub = getattr(rt, "rosout", None) if rt is not None else None
     if pub is None or rt.is_shutdown():
@@ -685,24 +690,24 @@ def _log(level: int, msg: Any, args: tuple, logger_name: str | None = None,
         del frame, caller
 
 
-def logdebug(msg: Any, *args: Any, logger_name: str | None = None) -> None:
-    _log(logging.DEBUG, msg, args, logger_name)
+def logdebug(msg: Any, *args: Any, **kwargs: Any) -> None:
+    _log(logging.DEBUG, msg, args, kwargs)
 
 
-def loginfo(msg: Any, *args: Any, logger_name: str | None = None) -> None:
-    _log(logging.INFO, msg, args, logger_name)
+def loginfo(msg: Any, *args: Any, **kwargs: Any) -> None:
+    _log(logging.INFO, msg, args, kwargs)
 
 
-def logwarn(msg: Any, *args: Any, logger_name: str | None = None) -> None:
-    _log(logging.WARNING, msg, args, logger_name)
+def logwarn(msg: Any, *args: Any, **kwargs: Any) -> None:
+    _log(logging.WARNING, msg, args, kwargs)
 
 
-def logerr(msg: Any, *args: Any, logger_name: str | None = None) -> None:
-    _log(logging.ERROR, msg, args, logger_name)
+def logerr(msg: Any, *args: Any, **kwargs: Any) -> None:
+    _log(logging.ERROR, msg, args, kwargs)
 
 
-def logfatal(msg: Any, *args: Any, logger_name: str | None = None) -> None:
-    _log(logging.CRITICAL, msg, args, logger_name)
+def logfatal(msg: Any, *args: Any, **kwargs: Any) -> None:
+    _log(logging.CRITICAL, msg, args, kwargs)
 
 
 # --- the rate-limited forms: each call site (file, line) keeps its own state, as in rospy;
@@ -723,8 +728,7 @@ def _call_site() -> tuple:
         del frame
 
 
-def _throttled(level: int, period: float, msg: Any, args: tuple,
-               logger_name: str | None) -> None:
+def _throttled(level: int, period: float, msg: Any, args: tuple, kwargs: dict) -> None:
     """At most one message per ``period`` seconds (ROS time, as rospy) from this call site."""
     key = ("throttle",) + _call_site()
     now = rostime.get_time()
@@ -735,11 +739,11 @@ def _throttled(level: int, period: float, msg: Any, args: tuple,
         if due:
             _site_state[key] = now
     if due:
-        _log(level, msg, args, logger_name, depth=3)
+        _log(level, msg, args, kwargs, depth=3)
 
 
 def _throttled_identical(level: int, period: float, msg: Any, args: tuple,
-                         logger_name: str | None) -> None:
+                         kwargs: dict) -> None:
     """A message different from the call site's previous one at once; a repeat of it only
     when ``period`` seconds have passed since it was last logged."""
     key = ("identical",) + _call_site()
@@ -751,79 +755,74 @@ def _throttled_identical(level: int, period: float, msg: Any, args: tuple,
         if due:
             _site_state[key] = (now, text)
     if due:
-        _log(level, text, (), logger_name, depth=3)
+        _log(level, text, (), kwargs, depth=3)
 
 
-def _once(level: int, msg: Any, args: tuple, logger_name: str | None) -> None:
+def _once(level: int, msg: Any, args: tuple, kwargs: dict) -> None:
     """Only the first message from this call site."""
     key = ("once",) + _call_site()
     with _site_lock:
         due = key not in _site_state
         _site_state[key] = True
     if due:
-        _log(level, msg, args, logger_name, depth=3)
+        _log(level, msg, args, kwargs, depth=3)
 
 
-def logdebug_throttle(period: float, msg: Any, *args: Any, logger_name: str | None = None) -> None:
-    _throttled(logging.DEBUG, period, msg, args, logger_name)
+def logdebug_throttle(period: float, msg: Any, *args: Any, **kwargs: Any) -> None:
+    _throttled(logging.DEBUG, period, msg, args, kwargs)
 
 
-def loginfo_throttle(period: float, msg: Any, *args: Any, logger_name: str | None = None) -> None:
-    _throttled(logging.INFO, period, msg, args, logger_name)
+def loginfo_throttle(period: float, msg: Any, *args: Any, **kwargs: Any) -> None:
+    _throttled(logging.INFO, period, msg, args, kwargs)
 
 
-def logwarn_throttle(period: float, msg: Any, *args: Any, logger_name: str | None = None) -> None:
-    _throttled(logging.WARNING, period, msg, args, logger_name)
+def logwarn_throttle(period: float, msg: Any, *args: Any, **kwargs: Any) -> None:
+    _throttled(logging.WARNING, period, msg, args, kwargs)
 
 
-def logerr_throttle(period: float, msg: Any, *args: Any, logger_name: str | None = None) -> None:
-    _throttled(logging.ERROR, period, msg, args, logger_name)
+def logerr_throttle(period: float, msg: Any, *args: Any, **kwargs: Any) -> None:
+    _throttled(logging.ERROR, period, msg, args, kwargs)
 
 
-def logfatal_throttle(period: float, msg: Any, *args: Any, logger_name: str | None = None) -> None:
-    _throttled(logging.CRITICAL, period, msg, args, logger_name)
+def logfatal_throttle(period: float, msg: Any, *args: Any, **kwargs: Any) -> None:
+    _throttled(logging.CRITICAL, period, msg, args, kwargs)
 
 
-def logdebug_throttle_identical(period: float, msg: Any, *args: Any,
-                                logger_name: str | None = None) -> None:
-    _throttled_identical(logging.DEBUG, period, msg, args, logger_name)
+def logdebug_throttle_identical(period: float, msg: Any, *args: Any, **kwargs: Any) -> None:
+    _throttled_identical(logging.DEBUG, period, msg, args, kwargs)
 
 
-def loginfo_throttle_identical(period: float, msg: Any, *args: Any,
-                               logger_name: str | None = None) -> None:
-    _throttled_identical(logging.INFO, period, msg, args, logger_name)
+def loginfo_throttle_identical(period: float, msg: Any, *args: Any, **kwargs: Any) -> None:
+    _throttled_identical(logging.INFO, period, msg, args, kwargs)
 
 
-def logwarn_throttle_identical(period: float, msg: Any, *args: Any,
-                               logger_name: str | None = None) -> None:
-    _throttled_identical(logging.WARNING, period, msg, args, logger_name)
+def logwarn_throttle_identical(period: float, msg: Any, *args: Any, **kwargs: Any) -> None:
+    _throttled_identical(logging.WARNING, period, msg, args, kwargs)
 
 
-def logerr_throttle_identical(period: float, msg: Any, *args: Any,
-                              logger_name: str | None = None) -> None:
-    _throttled_identical(logging.ERROR, period, msg, args, logger_name)
+def logerr_throttle_identical(period: float, msg: Any, *args: Any, **kwargs: Any) -> None:
+    _throttled_identical(logging.ERROR, period, msg, args, kwargs)
 
 
-def logfatal_throttle_identical(period: float, msg: Any, *args: Any,
-                                logger_name: str | None = None) -> None:
-    _throttled_identical(logging.CRITICAL, period, msg, args, logger_name)
+def logfatal_throttle_identical(period: float, msg: Any, *args: Any, **kwargs: Any) -> None:
+    _throttled_identical(logging.CRITICAL, period, msg, args, kwargs)
 
 
-def logdebug_once(msg: Any, *args: Any, logger_name: str | None = None) -> None:
-    _once(logging.DEBUG, msg, args, logger_name)
+def logdebug_once(msg: Any, *args: Any, **kwargs: Any) -> None:
+    _once(logging.DEBUG, msg, args, kwargs)
 
 
-def loginfo_once(msg: Any, *args: Any, logger_name: str | None = None) -> None:
-    _once(logging.INFO, msg, args, logger_name)
+def loginfo_once(msg: Any, *args: Any, **kwargs: Any) -> None:
+    _once(logging.INFO, msg, args, kwargs)
 
 
-def logwarn_once(msg: Any, *args: Any, logger_name: str | None = None) -> None:
-    _once(logging.WARNING, msg, args, logger_name)
+def logwarn_once(msg: Any, *args: Any, **kwargs: Any) -> None:
+    _once(logging.WARNING, msg, args, kwargs)
 
 
-def logerr_once(msg: Any, *args: Any, logger_name: str | None = None) -> None:
-    _once(logging.ERROR, msg, args, logger_name)
+def logerr_once(msg: Any, *args: Any, **kwargs: Any) -> None:
+    _once(logging.ERROR, msg, args, kwargs)
 
 
-def logfatal_once(msg: Any, *args: Any, logger_name: str | None = None) -> None:
-    _once(logging.CRITICAL, msg, args, logger_name)
+def logfatal_once(msg: Any, *args: Any, **kwargs: Any) -> None:
+    _once(logging.CRITICAL, msg, args, kwargs)

@@ -255,12 +255,15 @@ class ServiceProxy:
             sock.close()
 
 
-def wait_for_service(name: str, timeout: float | None = None) -> None:
-    """Block until ``name`` is registered and answers a probe; ``ROSException`` on timeout."""
+def wait_for_service(service: str, timeout: float | None = None) -> None:
+    """Block until ``service`` is registered and answers a probe; ``ROSException`` on
+    timeout (``timeout``: seconds or a Duration, None to wait for ever)."""
     from orchestra.node.runtime import get_runtime
 
     rt = get_runtime()
-    resolved = rt.resolve_name(name)
+    resolved = rt.resolve_name(service)
+    if timeout is not None and not isinstance(timeout, (int, float)):
+        timeout = timeout.to_sec()
     deadline = None if timeout is None else time.monotonic() + timeout
     delay = 0.01
     while True:

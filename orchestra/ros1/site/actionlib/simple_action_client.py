@@ -25,7 +25,10 @@ __all__ = ["SimpleActionClient", "SimpleGoalState"]
 
 class SimpleGoalState:
     PENDING, ACTIVE, DONE = 0, 1, 2
-    to_str = {0: "PENDING", 1: "ACTIVE", 2: "DONE"}
+
+    @staticmethod
+    def to_string(n: int) -> str:
+        return {0: "PENDING", 1: "ACTIVE", 2: "DONE"}.get(n, f"UNKNOWN({n})")
 
 
 class SimpleActionClient:

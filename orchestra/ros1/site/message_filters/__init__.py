@@ -148,25 +148,36 @@ class TimeSynchronizer(SimpleFilter):
     """One callback per set of messages, one from each filter in ``fs``, with the same
     stamp. At most ``queue_size`` stamps wait per input; the oldest are dropped."""
 
-    def __init__(self, fs: list[SimpleFilter], queue_size: int):
+    def __init__(self, fs: list[SimpleFilter], queue_size: int, reset: bool = False):
         super().__init__()
         self.queue_size = queue_size
+        self.reset = reset
+        self._last_added = Time()
         self.lock = threading.Lock()
         self.queues: list[dict[int, Any]] = [{} for _ in fs]
         self.connectInput(fs)
 
     def connectInput(self, fs: list[SimpleFilter]) -> None:  # noqa: N802
         self.queues = [{} for _ in fs]
-        self.input_connections = [f.registerCallback(self.add, q, self.lock)
-                                  for f, q in zip(fs, self.queues, strict=True)]
+        self.input_connections = [f.registerCallback(self.add, q, i)
+                                  for i, (f, q) in enumerate(zip(fs, self.queues, strict=True))]
 
-    def add(self, msg: Any, my_queue: dict[int, Any], my_queue_lock: Any = None) -> None:
+    def _check_reset(self) -> None:
+        """``reset``: ROS time jumped back (a restarted bag or simulator): forget the queues."""
+        now = Time.now()
+        if self.reset and now < self._last_added:
+            for q in self.queues:
+                q.clear()
+        self._last_added = now
+
+    def add(self, msg: Any, my_queue: dict[int, Any], my_queue_index: int | None = None) -> None:
         stamp = _stamp(msg, False)
         if stamp is None:
             log.warning("TimeSynchronizer needs messages with a header.stamp")
             return
         key = stamp.to_nsec()
         with self.lock:
+            self._check_reset()
             my_queue[key] = msg
             while len(my_queue) > self.queue_size:
                 del my_queue[min(my_queue)]
@@ -188,13 +199,11 @@ class ApproximateTimeSynchronizer(TimeSynchronizer):
 
     def __init__(self, fs: list[SimpleFilter], queue_size: int, slop: float,
                  allow_headerless: bool = False, reset: bool = False):
-        super().__init__(fs, queue_size)
+        super().__init__(fs, queue_size, reset)
         self.slop = Duration.from_sec(slop).to_nsec()
         self.allow_headerless = allow_headerless
-        self.reset = reset
-        self._last_added = Time()
 
-    def add(self, msg: Any, my_queue: dict[int, Any], my_queue_lock: Any = None) -> None:
+    def add(self, msg: Any, my_queue: dict[int, Any], my_queue_index: int | None = None) -> None:
         stamp = _stamp(msg, self.allow_headerless)
         if stamp is None:
             log.warning("Cannot use message filters with non-stamped messages. Use the "
@@ -203,11 +212,7 @@ class ApproximateTimeSynchronizer(TimeSynchronizer):
             return
         key = stamp.to_nsec()
         with self.lock:
-            now = Time.now()
-            if self.reset and now < self._last_added:
-                for q in self.queues:
-                    q.clear()
-            self._last_added = now
+            self._check_reset()
             my_queue[key] = msg
             while len(my_queue) > self.queue_size:
                 del my_queue[min(my_queue)]

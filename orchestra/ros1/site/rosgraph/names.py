@@ -5,8 +5,8 @@ import os
 import sys
 from collections.abc import Mapping
 
+from orchestra.names import anonymous_name as _anonymous_name
 from orchestra.names import (
-    anonymous_name,
     canonicalize,
     is_global,
     is_legal_base_name,
@@ -29,6 +29,11 @@ SEP = "/"
 PRIV_NAME = "~"
 ANYTYPE = "*"
 canonicalize_name = canonicalize
+
+
+def anonymous_name(id: str) -> str:  # noqa: A002 - rosgraph's parameter name
+    """A node name made unique with the host, pid and a random part."""
+    return _anonymous_name(id)
 
 
 def get_ros_namespace(env: Mapping[str, str] | None = None,

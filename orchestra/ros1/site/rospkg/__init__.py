@@ -8,8 +8,8 @@ from collections.abc import Mapping
 
 from orchestra.packages import PackageNotFound, get_index
 from orchestra.packages.deps import all_packages_graph, build_graph
-from orchestra.supervise.command import ros_home as get_ros_home
-from orchestra.supervise.output import log_dir_root as get_log_dir
+from orchestra.supervise.command import ros_home
+from orchestra.supervise.output import log_dir_root
 
 __all__ = ["ResourceNotFound", "RosPack", "get_log_dir", "get_ros_home",
            "get_ros_package_path"]
@@ -17,6 +17,10 @@ __all__ = ["ResourceNotFound", "RosPack", "get_log_dir", "get_ros_home",
 
 class ResourceNotFound(Exception):
     """A package that is not on the package path."""
+
+    def __init__(self, msg: str, ros_paths: builtins.list[str] | None = None):
+        super().__init__(msg)
+        self.ros_paths = ros_paths
 
 
 class RosPack:
@@ -54,6 +58,16 @@ class RosPack:
         if implicit:
             return graph.dependents(name)
         return sorted(graph.graph.predecessors(name))
+
+
+def get_ros_home(env: Mapping[str, str] | None = None) -> str:
+    """``$ROS_HOME``, else ``~/.ros``."""
+    return ros_home(env)
+
+
+def get_log_dir(env: Mapping[str, str] | None = None) -> str:
+    """``$ROS_LOG_DIR``, else ``$ROS_HOME/log``."""
+    return log_dir_root(dict(env) if env is not None else None)
 
 
 def get_ros_package_path(env: Mapping[str, str] | None = None) -> str | None:

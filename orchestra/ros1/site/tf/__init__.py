@@ -85,15 +85,30 @@ class Transformer:
     def canTransform(self, target_frame: str, source_frame: str, time: Any) -> bool:  # noqa: N802
         return self._buffer.can_transform(target_frame, source_frame, to_sec(time))
 
+    def canTransformFull(self, target_frame: str, target_time: Any, source_frame: str,  # noqa: N802
+                         source_time: Any, fixed_frame: str) -> bool:
+        return (self._buffer.can_transform(target_frame, fixed_frame, to_sec(target_time))
+                and self._buffer.can_transform(fixed_frame, source_frame, to_sec(source_time)))
+
+    def waitForTransformFull(self, target_frame: str, target_time: Any, source_frame: str,  # noqa: N802
+                             source_time: Any, fixed_frame: str, timeout: Any,
+                             polling_sleep_duration: Any = None) -> None:
+        self.waitForTransform(target_frame, fixed_frame, target_time, timeout)
+        self.waitForTransform(fixed_frame, source_frame, source_time, timeout)
+
+    def getTFPrefix(self) -> str:  # noqa: N802
+        """tf_prefix was dropped with tf2; always empty, as in tf on noetic."""
+        return ""
+
     def waitForTransform(self, target_frame: str, source_frame: str, time: Any,  # noqa: N802
                          timeout: Any, polling_sleep_duration: Any = None) -> None:
         """Block until the transform is available; ``tf.Exception`` after ``timeout``."""
         self._buffer.wait_for_transform(target_frame, source_frame, to_sec(time),
                                         to_sec(timeout), is_shutdown=_is_shutdown)
 
-    def getLatestCommonTime(self, source_frame: str, target_frame: str) -> Any:  # noqa: N802
+    def getLatestCommonTime(self, source_frame: str, dest_frame: str) -> Any:  # noqa: N802
         """The newest time both frames' chains have data for (a ``rospy.Time``)."""
-        _, used = self._buffer.lookup(target_frame, source_frame, 0.0)
+        _, used = self._buffer.lookup(dest_frame, source_frame, 0.0)
         return _rospy_time(used)
 
     # --- transforming stamped geometry_msgs ---------------------------------------------------
@@ -124,10 +139,11 @@ class Transformer:
             t[1], (v3s.vector.x, v3s.vector.y, v3s.vector.z))
         return out
 
-    def transformQuaternion(self, target_frame: str, qs: Any) -> Any:  # noqa: N802
-        t = self._transform_to(target_frame, qs.header)
-        out = self._stamped(qs, target_frame)
-        q = qs.quaternion
+    def transformQuaternion(self, target_frame: str, ps: Any) -> Any:  # noqa: N802
+        """A geometry_msgs/QuaternionStamped in ``target_frame``."""
+        t = self._transform_to(target_frame, ps.header)
+        out = self._stamped(ps, target_frame)
+        q = ps.quaternion
         out.quaternion.x, out.quaternion.y, out.quaternion.z, out.quaternion.w = \
             _tfm.quaternion_multiply(t[1], (q.x, q.y, q.z, q.w))
         return out
@@ -166,6 +182,12 @@ class TransformBroadcaster(_broadcaster.TransformBroadcaster):
     """tf.TransformBroadcaster: ``sendTransform(translation, rotation, time, child, parent)``;
     ``sendTransformMessage(transform_stamped)``."""
 
+    def sendTransform(self, translation: Any, rotation: Any, time: Any, child: str,  # noqa: N802
+                      parent: str) -> None:
+        """Send ``child``'s pose in ``parent`` at ``time`` on /tf."""
+        super().sendTransform(translation, rotation, time, child, parent)
+
     def sendTransformMessage(self, transform: Any) -> None:  # noqa: N802
-        self.sendTransform(transform)
+        """Send a geometry_msgs/TransformStamped on /tf."""
+        super().sendTransform(transform)
 

@@ -35,4 +35,7 @@ if __name__ == '__main__':
         rospy.loginfo_throttle(1.0, "turtle1 is %.2f m from turtle2"
                                % math.sqrt(trans[0] ** 2 + trans[1] ** 2))
 
-        rate.sleep()
+        try:
+            rate.sleep()
+        except rospy.ROSInterruptException:
+            break
