@@ -1,12 +1,11 @@
 """rosgraph.rosenv: the ROS environment variables a node reads."""
 from __future__ import annotations
 
-import os
 import sys
 from collections.abc import Mapping
 
 from orchestra.node.names import parse_args
-from orchestra.node.runtime import DEFAULT_MASTER_URI
+from orchestra.rpc import master_uri_from_env
 
 __all__ = ["ROS_MASTER_URI", "ROS_NAMESPACE", "get_master_uri"]
 
@@ -18,5 +17,4 @@ def get_master_uri(env: Mapping[str, str] | None = None, argv: list[str] | None 
     """``__master:=`` from ``argv`` (default ``sys.argv``), else ``ROS_MASTER_URI``, else
     the default master (rosgraph raises instead; orchestra's nodes use the default)."""
     special = parse_args(list(sys.argv if argv is None else argv)).special
-    env = os.environ if env is None else env
-    return special.get("__master") or env.get(ROS_MASTER_URI) or DEFAULT_MASTER_URI
+    return special.get("__master") or master_uri_from_env(env)

@@ -7,7 +7,6 @@ import threading
 from orchestra.node import runtime as _runtime
 from orchestra.node.runtime import (
     DEBUG,
-    DEFAULT_MASTER_URI,
     ERROR,
     FATAL,
     INFO,
@@ -27,6 +26,7 @@ from orchestra.node.runtime import (
     spin,
     wait_for_message,
 )
+from orchestra.rpc import master_uri_from_env
 
 from . import topics as _topics
 from .msproxy import MasterProxy
@@ -47,7 +47,7 @@ def get_master(env: os._Environ | dict = os.environ):
     with _master_lock:
         if _master is None:
             uri = (get_runtime().master_uri if is_initialized()
-                   else env.get("ROS_MASTER_URI") or DEFAULT_MASTER_URI)
+                   else master_uri_from_env(env))
             _master = MasterProxy(uri)
     return _master
 
