@@ -246,3 +246,25 @@ def test_msg_parser_keeps_string_constants_verbatim_and_resolves_relative_types(
     assert spec.constants[0].value == "hi # not a comment"
     assert [f.base for f in spec.fields] == ["std_msgs/Header", "pkg/Point"]
 
+
+
+def test_numpy_variants_give_numeric_arrays_of_the_field_dtype_as_genpy():
+    import io
+
+    Fix = get_message_class("sensor_msgs/NavSatFix")
+    buff = io.BytesIO()
+    Fix(position_covariance=np.arange(9.0)).serialize_numpy(buff, np)
+    back = Fix().deserialize_numpy(buff.getvalue(), np)
+    assert back.position_covariance.dtype == np.float64
+    assert back.position_covariance.tolist() == list(range(9))
+    Img = get_message_class("sensor_msgs/Image")
+    raw = io.BytesIO()
+    Img(data=b"\x01\x02").serialize(raw)
+    assert Img().deserialize_numpy(raw.getvalue(), np).data == b"\x01\x02"  # uint8[]: bytes
+
+
+def test_bad_bytes_raise_deserialization_error():
+    from orchestra.node.exceptions import DeserializationError
+
+    with pytest.raises(DeserializationError, match="cannot deserialize std_msgs/Header"):
+        get_message_class("std_msgs/Header")().deserialize(b"\x01")

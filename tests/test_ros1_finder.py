@@ -209,3 +209,12 @@ def test_a_node_importing_orchestra_directly_is_not_disturbed_by_the_layer():
     # orchestra.node's own imports probe optional modules (copy.py's "org") half-way through
     out = _run(sys.executable, "import orchestra.node, copy; print('ok')")
     assert out.returncode == 0 and out.stdout.strip() == "ok", out.stderr
+
+
+def test_layer_genpy_module_is_the_message_system_in_use():
+    out = _run(sys.executable, "import genpy, genpy.message; from std_msgs.msg import Header; "
+                               "h = Header(); print(isinstance(h, genpy.Message), "
+                               "isinstance(h.stamp, genpy.Time), "
+                               "genpy.message.strify_message(h) == str(h))")
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["True", "True", "True"]

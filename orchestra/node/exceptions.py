@@ -39,3 +39,7 @@ class TransportException(ROSException):
 
 class SerializationError(ROSException):
     """A message value does not fit its declared field type."""
+
+
+class DeserializationError(SerializationError):
+    """Bytes that are not a serialized message of the expected type (genpy's name)."""

@@ -15,7 +15,7 @@ from typing import Any
 import yaml
 
 from orchestra.node import msgdefs, msgspec
-from orchestra.node.exceptions import ROSException, SerializationError
+from orchestra.node.exceptions import DeserializationError, ROSException, SerializationError
 from orchestra.node.msgspec import MsgSpec, SrvSpec
 from orchestra.node.rostime import Duration, Time
 from orchestra.node.serialization import compile_codec
@@ -80,10 +80,10 @@ class Message:
             data = bytes(data)
         try:
             msg, _ = cls._deser(data, 0)
-        except SerializationError:
+        except DeserializationError:
             raise
         except Exception as exc:
-            raise SerializationError(f"cannot deserialize {cls._type}: {exc}") from exc
+            raise DeserializationError(f"cannot deserialize {cls._type}: {exc}") from exc
         return msg
 
     def serialize(self, buff) -> None:
@@ -96,6 +96,20 @@ class Message:
         for name in self._fields:
             setattr(self, name, getattr(other, name))
         return self
+
+    def serialize_numpy(self, buff, numpy=None) -> None:
+        """genpy's numpy variant: numpy arrays (and scalars) serialize like lists already."""
+        self.serialize(buff)
+
+    def deserialize_numpy(self, data, numpy) -> Message:
+        """genpy's numpy variant: numeric array fields (uint8[] stays bytes) become arrays of
+        their ROS type's dtype, in nested messages too."""
+        self.deserialize(data)
+        _to_numpy(self, numpy)
+        return self
+
+    def _get_types(self) -> list[str]:
+        return list(self._slot_types)
 
     # --- python niceties ----------------------------------------------------------------
     def __eq__(self, other) -> bool:
@@ -126,6 +140,23 @@ class Message:
     def __setstate__(self, state) -> None:
         for name, value in zip(self._fields, state, strict=False):
             setattr(self, name, value)
+
+
+_DTYPES = {"bool": "bool", "int8": "int8", "byte": "int8", "uint8": "uint8", "char": "uint8",
+           "int16": "int16", "uint16": "uint16", "int32": "int32", "uint32": "uint32",
+           "int64": "int64", "uint64": "uint64", "float32": "float32", "float64": "float64"}
+
+
+def _to_numpy(msg: Message, numpy: Any) -> None:
+    for f in msg._spec.fields if msg._spec is not None else ():
+        value = getattr(msg, f.name)
+        if f.array is not None and f.base in _DTYPES and f.base not in ("uint8", "char"):
+            setattr(msg, f.name, numpy.array(value, dtype=numpy.dtype(_DTYPES[f.base])))
+        elif isinstance(value, Message):
+            _to_numpy(value, numpy)
+        elif f.array is not None and not f.is_builtin:
+            for item in value:
+                _to_numpy(item, numpy)
 
 
 class AnyMsg(Message):
@@ -372,6 +403,12 @@ def _strify(value: Any, indent: str, slot_type: str = "") -> str:
         text = "\n".join(lines)
         return "\n" + text if indent else text
     return str(value)
+
+
+def strify_message(val: Any, indent: str = "") -> str:
+    """genpy's ``strify_message``: the text ``str(msg)`` gives; with ``indent``, a message's
+    lines are indented and preceded by a newline (how nested values are laid out)."""
+    return _strify(val, indent)
 
 
 def to_yaml_text(msg: Any) -> str:
