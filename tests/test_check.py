@@ -403,3 +403,15 @@ def test_check_flags_every_roslaunch_fixture_roslaunch_rejects(compat_dir, monke
             false_alarms.append([str(p) for p in errors])
     assert missed == []
     assert false_alarms == []
+
+
+def test_an_include_chain_longer_than_the_stack_is_checked_without_a_traceback(ws):
+    from orchestra.launch.interpreter import MAX_INCLUDE_DEPTH
+    depth = 1500  # deeper than Python's recursion limit
+    for i in range(depth):
+        write(ws / "launch", f"f{i}.launch",
+              f'<launch>\n  <include file="$(dirname)/f{i + 1}.launch"/>\n</launch>\n')
+    write(ws / "launch", f"f{depth}.launch", "<launch/>\n")
+    report = check_files([str(ws / "launch" / "f0.launch")])
+    assert [p.message for p in report.problems if p.severity == ERROR] == [
+        f"<include> attribute 'file': includes nest more than {MAX_INCLUDE_DEPTH} files deep"]

@@ -217,3 +217,16 @@ def test_output_both_is_accepted_and_other_modes_are_refused(write):
     assert plan.nodes[0].output == "both"
     with pytest.raises(OrchestraError, match="'log', 'screen', 'both'"):
         launch(write, '<node name="n" pkg="p" type="t" output="loud"/>')
+
+
+def test_include_chain_deeper_than_the_bound_is_a_located_error(write):
+    from orchestra.launch.interpreter import MAX_INCLUDE_DEPTH
+    depth = MAX_INCLUDE_DEPTH + 20
+    for i in range(depth):
+        write(f"f{i}.launch", f'<launch><include file="$(dirname)/f{i + 1}.launch"/></launch>')
+    write(f"f{depth}.launch", "<launch/>")
+    with pytest.raises(OrchestraError, match=f"more than {MAX_INCLUDE_DEPTH} files deep") as info:
+        load_launch(write("main.launch", '<launch><include file="$(dirname)/f0.launch"/>'
+                                         '</launch>'))
+    assert info.value.location.line == 1
+    assert len(str(info.value)) <= 2100

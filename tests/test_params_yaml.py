@@ -48,3 +48,25 @@ def test_syntax_error_names_file_and_line():
 def test_flatten_unrolls_dicts_to_leaves_and_skips_empty_dicts():
     assert flatten("/ns", {"a": {"b": 1, "c": [1, 2]}, "d": "x", "e": {}}) == [
         ("/ns/a/b", 1), ("/ns/a/c", [1, 2]), ("/ns/d", "x")]
+
+
+@pytest.mark.parametrize("text, position, why", [
+    ("a: " + "[" * 500 + "]" * 500 + "\n", (1, 103), "nested more than 100"),
+    ("a:\n  b: " + "{c: " * 200 + "1" + "}" * 200 + "\n", (2, None), "nested more than 100"),
+    ("a: &x [*x]\n", None, "nested more than 100"),
+    ("a: 1\nb: " + "1" * 5000 + "\n", (2, 4), "integer of 5000 characters"),
+    ("a: 0x" + "f" * 100000 + "\n", (1, 4), "integer of"),
+    ("a: 2001-12-14t21:59:43.10-99:00\n", (1, 4), "invalid timestamp value"),
+    ("a: !radians 9**9**9\n", (1, 4), "radian"),
+    ("a: !radians " + "-" * 5000 + "1\n", (1, 4), "radian"),
+    ('a: 1\nb: "x\x01"\n', (2, 6), r"U\+0001"),
+], ids=["deep-list", "deep-map", "self-alias", "long-int", "long-hex", "timestamp",
+        "radians-power", "radians-nesting", "control-char"])
+def test_hostile_values_are_refused_at_their_position(text, position, why):
+    with pytest.raises(OrchestraError, match=why) as info:
+        load_rosparam_yaml(text, "p.yaml")
+    location = info.value.location
+    assert location.file == "p.yaml" and location.line is not None
+    if position is not None:
+        assert location.line == position[0]
+        assert position[1] is None or location.column == position[1]

@@ -353,6 +353,17 @@ class Checker:
 
     # ---------------------------------------------------------------- one file
     def _check_file(self, path: str, passed_args: dict[str, str], top: bool) -> bool:
+        """Check ``path`` and, depth first, what it includes (a work list, not recursion:
+        an include chain may be longer than Python's stack)."""
+        pending: list[tuple[str, dict[str, str]]] = []
+        ok = self._check_one(path, passed_args, top, pending)
+        while pending:
+            target, args = pending.pop()
+            self._check_one(target, args, False, pending)
+        return ok
+
+    def _check_one(self, path: str, passed_args: dict[str, str], top: bool,
+                   pending: list[tuple[str, dict[str, str]]]) -> bool:
         if path in self._checked:
             return True
         self._checked.add(path)
@@ -393,8 +404,7 @@ class Checker:
                 if include is not None:
                     includes.append(include)
         self._check_args(path, declared, used, passes_all, set(passed_args), top)
-        for include in includes:
-            self._check_file(include.target, include.args, top=False)
+        pending.extend((include.target, include.args) for include in reversed(includes))
         return True
 
     def _walk(self, entity: Entity, parent: Entity | None, scope: _StaticScope,

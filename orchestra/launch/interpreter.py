@@ -53,6 +53,11 @@ REMAP_ATTRS = IF_UNLESS | {"from", "to"}
 ENV_ATTRS = IF_UNLESS | {"name", "value"}
 
 
+# Files deep an include chain may go (real trees are a handful deep; a chain of distinct files
+# has no cycle to stop it).
+MAX_INCLUDE_DEPTH = 100
+
+
 class LaunchError(OrchestraError):
     """A launch file roslaunch would reject (or that orchestra refuses for safety)."""
 
@@ -249,7 +254,12 @@ class Interpreter:
             if handler is None:
                 self._warn(entity, f"unrecognized tag <{tag}>")
                 continue
-            result = handler(self, entity, scope, default_machine)
+            try:
+                result = handler(self, entity, scope, default_machine)
+            except RecursionError:
+                # groups inside includes inside groups... deeper than Python's stack: the
+                # innermost element reached is where the file is refused
+                raise self._error(entity, "elements and includes nest too deeply") from None
             if tag in ("group", "include", "machine") and result is not None:
                 default_machine = result
         return default_machine
@@ -712,6 +722,9 @@ class Interpreter:
         if key in scope.include_stack:
             chain = " -> ".join([*scope.include_stack, key])
             raise self._error(entity, f"include cycle: {chain}", "file")
+        if len(scope.include_stack) >= MAX_INCLUDE_DEPTH:
+            raise self._error(entity, f"includes nest more than {MAX_INCLUDE_DEPTH} files deep",
+                              "file")
         if not os.path.isfile(filename):
             raise self._error(entity, f"included file does not exist: [{filename}]", "file")
         root = self._parse(filename)

@@ -35,6 +35,8 @@ from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 
 from orchestra.errors import Location, OrchestraError, offset_location
 from orchestra.launch.entity import Entity
+from orchestra.params.yaml import char_name as _char_name
+from orchestra.params.yaml import reader_error_location
 
 # The element key holding the element's own text (inline rosparam YAML).
 TEXT_KEY = "text"
@@ -133,16 +135,9 @@ def _compose(text: str, filename: str) -> Node | None:
         context = f" ({exc.context})" if exc.context else ""
         raise LaunchYamlError(f"invalid YAML: {problem}{context}", where) from None
     except pyyaml.reader.ReaderError as exc:
-        # the reader refuses a character (a control character...) and knows only its offset:
-        # a byte offset into the UTF-8 text with libyaml, a character offset without it
-        data = text if _LOADER is pyyaml.SafeLoader else text.encode("utf-8")
-        where = offset_location(filename, data, exc.position)
-        if isinstance(data, bytes):  # report the column in characters, as marks do
-            line_start = data.rfind(b"\n", 0, exc.position) + 1
-            column = len(data[line_start:exc.position].decode("utf-8", "replace")) + 1
-            where = Location(filename, where.line, column)
         raise LaunchYamlError(f"invalid YAML: character {_char_name(exc.character)} is not "
-                              f"allowed ({exc.reason})", where) from None
+                              f"allowed ({exc.reason})",
+                              reader_error_location(exc, text, filename, _LOADER)) from None
     except pyyaml.YAMLError as exc:
         raise LaunchYamlError(f"invalid YAML: {exc}", Location(filename, 1, 1)) from None
     documents = [doc for doc in documents if doc is not None]
@@ -150,11 +145,6 @@ def _compose(text: str, filename: str) -> Node | None:
         raise LaunchYamlError("a YAML launch file holds exactly one document (found a second "
                               "'---')", _location(filename, documents[1]))
     return documents[0] if documents else None
-
-
-def _char_name(character: str | int) -> str:
-    code = character if isinstance(character, int) else ord(character)
-    return f"U+{code:04X}"
 
 
 def _refuse_foreign_tags(root: Node, filename: str) -> None:

@@ -17,7 +17,7 @@ from typing import Any
 
 import yaml
 
-from orchestra.errors import Location, OrchestraError
+from orchestra.errors import Location, OrchestraError, offset_location
 from orchestra.names import ns_join
 
 
@@ -37,7 +37,8 @@ def _arith(node: ast.AST) -> float:
         return _arith(node.body)
     if isinstance(node, ast.Constant) and isinstance(node.value, (int, float)) \
             and not isinstance(node.value, bool):
-        return node.value
+        # floats throughout: 9**9**9 overflows at once instead of building a huge integer
+        return float(node.value)
     if isinstance(node, ast.Name) and node.id == "pi":
         return math.pi
     if isinstance(node, ast.BinOp) and type(node.op) in _BINOPS:
@@ -49,6 +50,8 @@ def _arith(node: ast.AST) -> float:
 
 def angle_expression(text: str) -> float:
     """Evaluate an angle expression such as ``pi/2`` or ``-1.5*pi`` (no names but ``pi``)."""
+    if len(text) > 1000:
+        raise ValueError("the expression is longer than 1000 characters")
     return float(_arith(ast.parse(text.strip(), mode="eval")))
 
 
@@ -63,7 +66,8 @@ def _construct_radians(loader: yaml.SafeLoader, node: yaml.ScalarNode) -> float:
     text = _unwrap(loader.construct_scalar(node), "rad")
     try:
         return angle_expression(text)
-    except (ValueError, SyntaxError, ZeroDivisionError, TypeError) as exc:
+    except (ValueError, SyntaxError, ArithmeticError, TypeError, RecursionError,
+            MemoryError) as exc:
         raise yaml.constructor.ConstructorError(
             None, None, f"invalid radian expression {text!r}: {exc}", node.start_mark) from None
 
@@ -77,9 +81,27 @@ def _construct_degrees(loader: yaml.SafeLoader, node: yaml.ScalarNode) -> float:
             None, None, f"invalid degree value {text!r}", node.start_mark) from None
 
 
+# Bounds on what a YAML value may build (the same spirit as $(eval)'s): nesting levels, and
+# the length of an integer's text (1300 digits is ~4300 bits; Python refuses to convert
+# longer decimal text anyway, with no position).
+MAX_DEPTH = 100
+MAX_INT_TEXT = 1300
+_INT_TAG = "tag:yaml.org,2002:int"
+
+
 class RosparamLoader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):  # type: ignore[misc]
     """PyYAML's safe loader (libyaml-backed when available: same results, much faster) plus
     rosparam's angle tags; a subclass, so the global loaders stay untouched."""
+
+    def construct_object(self, node: yaml.Node, deep: bool = False) -> Any:
+        # a constructor's own ValueError (an impossible timestamp...) carries no position:
+        # give it the node's
+        try:
+            return super().construct_object(node, deep)
+        except (ValueError, OverflowError, TypeError) as exc:
+            raise yaml.constructor.ConstructorError(
+                None, None, f"invalid {node.tag.rsplit(':', 1)[-1]} value: {exc}",
+                node.start_mark) from None
 
 
 RosparamLoader.add_constructor("!radians", _construct_radians)
@@ -99,17 +121,85 @@ def load_rosparam_yaml(text: str, filename: str = "<yaml>") -> Any:
 
 def load_yaml_value(text: str, filename: str = "<yaml>") -> Any:
     """Like ``load_rosparam_yaml`` but an empty document is ``None`` (``type="yaml"`` params)."""
+    loader = RosparamLoader(text)
     try:
-        data = yaml.load(text, Loader=RosparamLoader)  # noqa: S506 (safe subclass)
+        node = loader.get_single_node()
+        if node is None:
+            return None
+        _check_bounds(node, filename)
+        return loader.construct_document(node)
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
-        line = mark.line + 1 if mark is not None else None
+        line = mark.line + 1 if mark is not None else 1
         col = mark.column + 1 if mark is not None else None
         raise RosparamYamlError(f"invalid YAML: {exc.problem or exc}",
                                 Location(filename, line, col)) from None
+    except yaml.reader.ReaderError as exc:
+        raise RosparamYamlError(f"invalid YAML: character {char_name(exc.character)} is not "
+                                f"allowed ({exc.reason})",
+                                reader_error_location(exc, text, filename,
+                                                      RosparamLoader)) from None
     except yaml.YAMLError as exc:
-        raise RosparamYamlError(f"invalid YAML: {exc}", Location(filename)) from None
-    return data
+        raise RosparamYamlError(f"invalid YAML: {exc}", Location(filename, 1)) from None
+    finally:
+        loader.dispose()
+
+
+def _check_bounds(root: yaml.Node, filename: str) -> None:
+    """Refuse nesting deeper than ``MAX_DEPTH`` and oversized integers, at their position.
+
+    Aliases make the node tree a graph: each node is visited once (its deepest level found
+    via the order of a depth-first walk is enough to bound what construction recurses
+    through), and an alias that contains itself stops the walk like a deep nesting would.
+    """
+    stack: list[tuple[yaml.Node, int]] = [(root, 1)]
+    seen: dict[int, int] = {}
+    while stack:
+        node, depth = stack.pop()
+        if depth > MAX_DEPTH:
+            raise RosparamYamlError(f"nested more than {MAX_DEPTH} levels deep",
+                                    _node_location(filename, node))
+        if seen.get(id(node), 0) >= depth:
+            continue
+        seen[id(node)] = depth
+        if isinstance(node, yaml.ScalarNode):
+            if node.tag == _INT_TAG and len(node.value) > MAX_INT_TEXT:
+                raise RosparamYamlError(f"integer of {len(node.value)} characters (at most "
+                                        f"{MAX_INT_TEXT})", _node_location(filename, node))
+        elif isinstance(node, yaml.SequenceNode):
+            stack.extend((child, depth + 1) for child in node.value)
+        elif isinstance(node, yaml.MappingNode):
+            for key, value in node.value:
+                stack.append((key, depth + 1))
+                stack.append((value, depth + 1))
+
+
+def _node_location(filename: str, node: yaml.Node) -> Location:
+    return Location(filename, node.start_mark.line + 1, node.start_mark.column + 1)
+
+
+def char_name(character: str | int) -> str:
+    code = character if isinstance(character, int) else ord(character)
+    return f"U+{code:04X}"
+
+
+try:
+    from yaml._yaml import CParser as _C_PARSER
+except ImportError:  # PyYAML built without libyaml
+    _C_PARSER = ()  # type: ignore[misc, assignment]
+
+
+def reader_error_location(exc: yaml.reader.ReaderError, text: str, filename: str,
+                          loader: type) -> Location:
+    """Where the YAML reader refused a character: it reports only an offset, in UTF-8 bytes
+    with libyaml and in characters without it; the column is given in characters."""
+    if not issubclass(loader, _C_PARSER):
+        return offset_location(filename, text, exc.position)
+    data = text.encode("utf-8")
+    where = offset_location(filename, data, exc.position)
+    line_start = data.rfind(b"\n", 0, exc.position) + 1
+    column = len(data[line_start:exc.position].decode("utf-8", "replace")) + 1
+    return Location(filename, where.line, column)
 
 
 def flatten(name: str, value: Any) -> list[tuple[str, Any]]:
@@ -131,4 +221,4 @@ def flatten(name: str, value: Any) -> list[tuple[str, Any]]:
 
 
 __all__ = ["RosparamLoader", "RosparamYamlError", "angle_expression", "flatten",
-           "load_rosparam_yaml", "load_yaml_value"]
+           "char_name", "load_rosparam_yaml", "load_yaml_value", "reader_error_location"]
