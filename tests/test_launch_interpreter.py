@@ -229,4 +229,5 @@ def test_include_chain_deeper_than_the_bound_is_a_located_error(write):
         load_launch(write("main.launch", '<launch><include file="$(dirname)/f0.launch"/>'
                                          '</launch>'))
     assert info.value.location.line == 1
-    assert len(str(info.value)) <= 2100
+    from orchestra.errors import MAX_MESSAGE
+    assert len(info.value.message) <= MAX_MESSAGE + len("... (100000 chars)")
