@@ -57,11 +57,14 @@ class SimpleActionClient:
     # --- the server ------------------------------------------------------------------------------
 
     def _server_ready(self) -> bool:
+        """A server's status arrived, it takes our goals and cancels, and its feedback and
+        result reach us (else the first feedback of a goal sent now could be lost)."""
         return (self._server_seen and self._goal_pub.get_num_connections() > 0
-                and self._cancel_pub.get_num_connections() > 0)
+                and self._cancel_pub.get_num_connections() > 0
+                and all(sub.get_num_connections() > 0 for sub in self._subs))
 
     def wait_for_server(self, timeout: Any = None) -> bool:
-        """True once a server publishes status and listens to goals and cancels; False if
+        """True once a server is connected both ways (``_server_ready``); False if
         ``timeout`` passes first (zero/None: wait for ever)."""
         return self._wait(self._server_ready, timeout, poll=True)
 
