@@ -261,3 +261,57 @@ def status(as_json: bool, socket_path: str | None, use_master: bool,
         for line in table_lines(launch["nodes"]):
             click.echo(line)
     return 0
+
+
+@click.command(name="test", context_settings={"help_option_names": ["-h", "--help"]})
+@click.argument("words", nargs=-1)
+@click.option("--junit-xml", "junit_xml", type=click.Path(dir_okay=False), default=None,
+              help="Write the combined JUnit XML here (default: "
+                   "RESULTS_DIR/<pkg>/rostest-<file>.xml).")
+@click.option("--results-dir", type=click.Path(file_okay=False), default=None,
+              help="Where tests write their results (default: ROS_TEST_RESULTS_DIR, else "
+                   "ROS_HOME/test_results).")
+@click.option("--text", is_flag=True,
+              help="Test output on the console, and --text passed to each test.")
+@click.option("--reuse-master", "-r", is_flag=True,
+              help="Use the master at ROS_MASTER_URI for every test instead of a fresh one.")
+@click.option("-t", "--test", "only", multiple=True, metavar="TEST",
+              help="Run only this test (its test-name; repeatable).")
+@click.option("--sigint-timeout", type=click.FloatRange(min=0), default=15.0,
+              show_default=True, help="Seconds a node has to exit after SIGINT.")
+@click.option("--sigterm-timeout", type=click.FloatRange(min=0), default=2.0,
+              show_default=True, help="Seconds a node has to exit after SIGTERM, then SIGKILL.")
+def test_command(words: tuple[str, ...], junit_xml: str | None, results_dir: str | None,
+                 text: bool, reuse_master: bool, only: tuple[str, ...],
+                 sigint_timeout: float, sigterm_timeout: float) -> None:
+    """Run a launch file's <test>s as rostest does: orchestra test [PKG] FILE [name:=value ...].
+
+    Each test gets the file's nodes on a fresh master, --gtest_output=xml:PATH and its
+    time-limit; the summary and one combined JUnit file report every test. Exit code 0 when
+    every test passed, 1 otherwise, 2 for a launch file that cannot be loaded.
+    """
+    from orchestra.app.junit import PASSED, combined_xml, summary_lines
+    from orchestra.app.options import RunOptions
+    from orchestra.app.testrun import TestOptions, TestRunner, select_tests
+    from orchestra.launch.load import interpret
+
+    paths, args = launch_words(words, "test")
+    interp = interpret(paths, args, no_exec=False, roscore=True, keep_broken_tests=True)
+    plan = interp.plan()
+    options = TestOptions(results_dir=results_dir, text=text, reuse_master=reuse_master,
+                          only=only)
+    tests, broken = select_tests(plan.tests, interp.broken_tests, only)
+    if not tests and not broken:
+        raise OrchestraError(f"{paths[0]}: no <test> to run")
+    runner = TestRunner(plan, paths[0], options,
+                        RunOptions(sigint_timeout=sigint_timeout,
+                                   sigterm_timeout=sigterm_timeout), echo_err)
+    outcomes = runner.run(tests, broken)
+    stem = os.path.splitext(os.path.basename(paths[0]))[0]
+    out = junit_xml or os.path.join(runner.results_dir, f"rostest-{stem}.xml")
+    os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
+    with open(out, "wb") as fh:
+        fh.write(combined_xml(f"{runner.package}.{stem}", outcomes))
+    click.echo("\n".join(summary_lines(outcomes, colour=sys.stdout.isatty())))
+    click.echo(f"\nJUnit results: {out}")
+    sys.exit(0 if all(o.verdict == PASSED for o in outcomes) else 1)

@@ -83,6 +83,9 @@ class LoadOptions:
     no_exec: bool = False
     roscore: bool = False
     ros_namespace: str | None = None
+    # orchestra test: a broken <test> becomes an entry of Interpreter.broken_tests (reported
+    # as that test's error) instead of failing the whole file, so the other tests still run
+    keep_broken_tests: bool = False
 
 
 def _is_yaml(path: str) -> bool:
@@ -114,6 +117,7 @@ class Interpreter:
         self.param_actions: list[ParamAction] = []
         self.nodes: list[Node] = []
         self.tests: list[Test] = []
+        self.broken_tests: list[tuple[str, LaunchError]] = []   # (label, why); see LoadOptions
         self.machines: dict[str, Machine] = {"": Machine(name="")}
         self.files: list[str] = []
         self.warnings: list[str] = []
@@ -565,7 +569,15 @@ class Interpreter:
 
     def _test(self, entity: Entity, scope: Scope, default_machine: Machine | None
               ) -> None:
-        self._node_or_test(entity, scope, default_machine, is_test=True)
+        if not self.options.keep_broken_tests:
+            self._node_or_test(entity, scope, default_machine, is_test=True)
+            return None
+        try:
+            self._node_or_test(entity, scope, default_machine, is_test=True)
+        except LaunchError as exc:
+            label = (entity.attributes.get("test-name") or entity.attributes.get("name")
+                     or f"<test> at {entity.location}")
+            self.broken_tests.append((label, exc))
         return None
 
     def _test_attrs(self, entity: Entity, scope: Scope) -> tuple[str, float, int]:

@@ -52,9 +52,12 @@ def split_words(words: tuple[str, ...]) -> tuple[list[str], dict[str, str]]:
     return files, args
 
 
-def interpret(files: list[str], args: dict[str, str], *, no_exec: bool, roscore: bool):
+def interpret(files: list[str], args: dict[str, str], *, no_exec: bool, roscore: bool,
+              keep_broken_tests: bool = False) -> Any:
+    """The Interpreter after loading ``files`` (its ``plan()``, ``broken_tests``...)."""
     from orchestra.launch.interpreter import Interpreter, LoadOptions
-    interp = Interpreter(LoadOptions(args=args, no_exec=no_exec, roscore=roscore))
+    interp = Interpreter(LoadOptions(args=args, no_exec=no_exec, roscore=roscore,
+                                     keep_broken_tests=keep_broken_tests))
     for path in files:
         if path == "-":
             from orchestra.launch.xml import parse_string
