@@ -12,8 +12,6 @@ from __future__ import annotations
 import threading
 from typing import Any
 
-import yaml
-
 from orchestra.node import msgdefs, msgspec
 from orchestra.node.exceptions import DeserializationError, ROSException, SerializationError
 from orchestra.node.msgspec import MsgSpec, SrvSpec
@@ -378,6 +376,8 @@ def _strify(value: Any, indent: str, slot_type: str = "") -> str:
     if isinstance(value, str):
         if not value:
             return "''"
+        import yaml  # here: a message import should not pay for YAML until one is printed
+
         return yaml.dump(value, default_style='"').rstrip("\n")
     if isinstance(value, (Time, Duration)):
         return f"\n{indent}secs: {value.secs}\n{indent}nsecs: {value.nsecs:9d}"
@@ -389,6 +389,8 @@ def _strify(value: Any, indent: str, slot_type: str = "") -> str:
         first = value[0]
         if isinstance(first, str):
             # genpy: a YAML block list, one "- item" line per string at this field's indent
+            import yaml
+
             text = yaml.dump(list(value), default_flow_style=False)
             return "\n" + "\n".join(indent + line for line in text.splitlines())
         if type(first) in (int, float, bool):
