@@ -218,3 +218,34 @@ def test_layer_genpy_module_is_the_message_system_in_use():
                                "genpy.message.strify_message(h) == str(h))")
     assert out.returncode == 0, out.stderr
     assert out.stdout.split() == ["True", "True", "True"]
+
+
+def test_action_types_have_genactions_text_for_debians_actionlib_actions():
+    from orchestra.node import msgspec
+
+    share = Path("/usr/share/actionlib")
+    actions = sorted((share / "action").glob("*.action")) if share.is_dir() else []
+    if not actions or not (share / "msg").is_dir():
+        pytest.skip("Debian's actionlib .action/.msg files are absent (python3-actionlib)")
+    for action in actions:
+        texts = msgspec.action_message_texts(action.read_text(), f"actionlib/{action.stem}")
+        for type_name, (text, _line) in texts.items():
+            generated = share / "msg" / (type_name.split("/")[1] + ".msg")
+            assert text == generated.read_text(), type_name
+
+
+def test_orchestra_run_gives_a_python_script_the_layer(tmp_path):
+    pkg = _package(tmp_path, "l10_run", {
+        "msg/Person.msg": "string name\n",
+        "scripts/hello.py": ("#!/usr/bin/env python3\n"
+                             "from l10_run.msg import Person\n"
+                             "from std_msgs.msg import String\n"
+                             "print(Person(name='ann').name, String._type)\n"),
+    })
+    (pkg / "scripts" / "hello.py").chmod(0o755)
+    env = dict(os.environ, PYTHONPATH=str(REPO), ROS_PACKAGE_PATH=str(tmp_path),
+               PATH=os.pathsep.join([os.path.dirname(sys.executable), os.environ["PATH"]]))
+    out = subprocess.run([sys.executable, "-m", "orchestra", "run", "l10_run", "hello.py"],
+                         env=env, capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["ann", "std_msgs/String"]

@@ -212,7 +212,8 @@ def action_message_texts(text: str, action_type: str, source: str | None = None
     return {
         f"{action_type}Goal": (b + goal, l1 - 1),
         f"{action_type}Result": (b + result, l2 - 1),
-        f"{action_type}Feedback": (b + feedback, l3 - 1),
+        # genaction ends the last part with one more newline than the file has
+        f"{action_type}Feedback": (b + feedback + "\n", l3 - 1),
         f"{action_type}Action": (
             f"{b}\n{name}ActionGoal action_goal\n{name}ActionResult action_result\n"
             f"{name}ActionFeedback action_feedback\n", 0),
