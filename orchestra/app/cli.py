@@ -8,10 +8,11 @@ command runs.
 """
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from typing import Any
 
 import click
@@ -52,6 +53,18 @@ _OPTIONS = [
     click.option("--status/--no-status", "status_view", default=None,
                  help="Live status table under the output (default: on a terminal)."),
     click.option("--with-tests", is_flag=True, help="Also run the <test> nodes (test mode)."),
+    click.option("--pid", "pid_file", default=None, metavar="FILE",
+                 help="Write orchestra's pid to FILE (removed when the launch ends)."),
+    click.option("--no-summary", is_flag=True, help="Do not print the SUMMARY block."),
+    click.option("-t", "--timeout", "socket_timeout",
+                 type=click.FloatRange(min=0, min_open=True), default=None, metavar="SECONDS",
+                 help="Socket connection timeout of the master and of calls to it "
+                      "(roslaunch's -t; default: none)."),
+    click.option("--skip-log-check", is_flag=True,
+                 help="Do not check the size of the log directory (warned past 1 GB)."),
+    click.option("-c", "--child", "child_name", default=None, metavar="NAME", hidden=True),
+    click.option("-u", "--server_uri", "--server-uri", "server_uri", default=None,
+                 metavar="URI", hidden=True),
     click.option("--no-rosout", is_flag=True,
                  help="Do not start /rosout with the embedded master (roscore's log "
                       "aggregator: /rosout_agg and rosout.log)."),
@@ -81,11 +94,81 @@ def echo_err(text: str) -> None:
     click.echo(text, err=True)
 
 
-def serve_plan(plan: Any, options: Any) -> int:
-    """Run ``plan`` in the foreground until it ends; orchestra's exit code."""
-    from orchestra.app.run import LaunchRun
+LOG_CHECK_BYTES = 1 << 30
 
-    report = LaunchRun(plan, options, report=echo_err).serve()
+
+def log_size_warning(root: str, limit: int = LOG_CHECK_BYTES) -> str | None:
+    """roslaunch's log-directory check: a warning once the logs pass ``limit`` bytes."""
+    total = 0
+    for dirpath, _, files in os.walk(root):
+        for name in files:
+            try:
+                total += os.lstat(os.path.join(dirpath, name)).st_size
+            except OSError:
+                continue
+            if total > limit:
+                return (f"WARNING: disk usage in log directory [{root}] is over "
+                        f"{limit / (1 << 30):g}GB.\nIt's recommended that you delete old "
+                        "run directories there (--skip-log-check skips this check).")
+    return None
+
+
+@contextlib.contextmanager
+def pid_file(path: str | None) -> Iterator[None]:
+    """roslaunch's ``--pid``: this process's pid in ``path`` while the run lasts."""
+    if path is None:
+        yield
+        return
+    path = os.path.expanduser(path)
+    try:
+        os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+        with open(path, "w", encoding="utf-8") as fh:
+            fh.write(str(os.getpid()))
+    except OSError as exc:
+        raise OrchestraError(f"--pid: cannot write {path}: {exc.strerror or exc}") from None
+    try:
+        yield
+    finally:
+        try:
+            os.unlink(path)
+        except OSError:
+            pass
+
+
+def print_summary(plan: Any) -> Callable[[list[Any], list[Any], str], None]:
+    """The ``announce`` of a run: roslaunch's SUMMARY, then ``ROS_MASTER_URI=...``."""
+    from orchestra.launch.summary import summary
+    from orchestra.master import core_params
+
+    def announce(nodes: list[Any], remote: list[Any], master_uri: str) -> None:
+        core = {k: v for k, v in core_params().items() if k != "/run_id"}
+        click.echo(summary(plan, core, nodes + remote, remote=bool(remote)))
+        click.echo(f"ROS_MASTER_URI={master_uri}\n")
+
+    return announce
+
+
+def serve_plan(plan: Any, options: Any, cli: dict[str, Any] | None = None) -> int:
+    """Run ``plan`` in the foreground until it ends; orchestra's exit code.
+
+    ``cli``: roslaunch's flags that shape the run from outside (pid file, summary, log check,
+    socket timeout).
+    """
+    import socket
+
+    from orchestra.app.run import LaunchRun
+    from orchestra.supervise.output import log_dir_root
+
+    cli = cli or {}
+    if cli.get("socket_timeout") is not None:
+        socket.setdefaulttimeout(cli["socket_timeout"])   # rosmaster's -t: every socket
+    if not cli.get("skip_log_check"):
+        warning = log_size_warning(log_dir_root())
+        if warning:
+            echo_err(warning)
+    announce = None if cli.get("no_summary") else print_summary(plan)
+    with pid_file(cli.get("pid_file")):
+        report = LaunchRun(plan, options, report=echo_err, announce=announce).serve()
     if report.exit_code != 0:
         echo_err(f"orchestra: error: {report.reason}")
     else:
@@ -137,14 +220,25 @@ def launch_words(words: tuple[str, ...], command: str) -> tuple[list[str], dict[
 @click.option("--ros-args", is_flag=True, help="Show the launch file's <arg>s and exit.")
 @click.option("--no-exec", is_flag=True,
               help="Do not run command= params; record them as {__command__: cmd}.")
+@click.option("--core", "core_only", is_flag=True,
+              help="Run the core only (master, parameter server, rosout), like roscore.")
 @run_options
-def launch(words: tuple[str, ...], dump_plan: bool, dump_params: bool, nodes: bool,
-           node_args: str | None, files: bool, find_node: str | None, ros_args: bool,
-           no_exec: bool, **run_opts: Any) -> None:
+@click.pass_context
+def launch(ctx: click.Context, words: tuple[str, ...], dump_plan: bool, dump_params: bool,
+           nodes: bool, node_args: str | None, files: bool, find_node: str | None,
+           ros_args: bool, no_exec: bool, core_only: bool, **run_opts: Any) -> None:
     """Resolve and run a roslaunch file: orchestra launch [PKG] FILE [name:=value ...]."""
     from orchestra.launch.load import find_node as find_declared
     from orchestra.launch.load import interpret, ros_args_text
 
+    cli_only = {k: run_opts.pop(k) for k in _CLI_ONLY}
+    if cli_only.get("child_name") or cli_only.get("server_uri"):
+        raise OrchestraError("-c/--child and -u/--server_uri run roslaunch as the child of a "
+                             "remote parent launch; orchestra starts the nodes of remote "
+                             "machines itself (see docs/remote.md), so it has no child mode")
+    if core_only:
+        _launch_core(ctx, words, run_opts, cli_only)
+        return
     paths, args = launch_words(words, "launch")
     if ros_args:
         click.echo(ros_args_text(paths, args))
@@ -182,7 +276,33 @@ def launch(words: tuple[str, ...], dump_plan: bool, dump_params: bool, nodes: bo
         node = find_declared(plan, find_node)
         click.echo(node.filename or "")
     else:
-        sys.exit(serve_plan(plan, options_from_cli(run_opts)))
+        sys.exit(serve_plan(plan, options_from_cli(run_opts), cli_only))
+
+
+# roslaunch's flags that the CLI handles around a run (not RunOptions of the run itself)
+_CLI_ONLY = ("pid_file", "no_summary", "socket_timeout", "skip_log_check", "child_name",
+             "server_uri")
+
+
+def _launch_core(ctx: click.Context, words: tuple[str, ...], run_opts: dict[str, Any],
+                 cli_only: dict[str, Any]) -> None:
+    """``launch --core``: ``orchestra core`` under roslaunch's rules (no files, no --wait,
+    and a pid file, by default ``$ROS_HOME/roscore-<port>.pid``, while it runs)."""
+    from orchestra.master import master_uri_from_env, port_from_uri
+    from orchestra.supervise.command import ros_home
+
+    if words:
+        raise click.UsageError("launch files are not allowed with --core")
+    if run_opts.get("wait"):
+        raise click.UsageError("--wait cannot be used with --core")
+    port = run_opts.get("port")
+    port = port_from_uri(master_uri_from_env()) if port is None else port
+    if cli_only.get("socket_timeout") is not None:
+        import socket
+
+        socket.setdefaulttimeout(cli_only["socket_timeout"])
+    with pid_file(cli_only.get("pid_file") or os.path.join(ros_home(), f"roscore-{port}.pid")):
+        ctx.invoke(core, port=port, host=None, no_rosout=bool(run_opts.get("no_rosout")))
 
 
 @click.command()

@@ -37,7 +37,7 @@ from orchestra.app.master import (
     upload,
 )
 from orchestra.app.options import RunOptions
-from orchestra.launch.plan import LaunchPlan
+from orchestra.launch.plan import LaunchPlan, Node
 from orchestra.rpc import TRANSPORT_ERRORS, proxy
 from orchestra.supervise import control
 from orchestra.supervise.output import Screen, prepare_run_log_dir
@@ -99,15 +99,20 @@ class LaunchRun:
     """A plan brought up under supervision; see the module docstring.
 
     ``report`` receives orchestra's one-line messages for the user (the CLI prints them on
-    stderr; the API default logs them). Node output goes to ``screen``.
+    stderr; the API default logs them). Node output goes to ``screen``. ``announce`` is
+    called once the plan passed every check and the master is up, before any node starts,
+    with the nodes to run here, the remote ones and the master URI (the CLI prints
+    roslaunch's SUMMARY there).
     """
 
     def __init__(self, plan: LaunchPlan, options: RunOptions | None = None,
-                 report: Callable[[str], None] | None = None, screen: Screen | None = None):
+                 report: Callable[[str], None] | None = None, screen: Screen | None = None,
+                 announce: Callable[[list[Node], list[Node], str], None] | None = None):
         self.plan = plan
         self.options = options or RunOptions()
         self._report = report or _log_report
         self._screen = screen
+        self._announce = announce
         self.master: MasterConnection | None = None
         self.log_dir: str | None = None
         self.supervisor: Supervisor | None = None
@@ -306,6 +311,8 @@ class LaunchRun:
                 self._closers.append(session.close)
             self.master = master = connect_master(opts, self._report,
                                                   public=session is not None)
+            if self._announce is not None:
+                self._announce(nodes, [] if opts.local else remote, master.uri)
             self.log_dir = prepare_run_log_dir(master.run_id, environ)
             run_param_actions(plan, master.uri, self._report)
             upload(plan, master)
