@@ -10,7 +10,7 @@ constructor taking positional or keyword field values (every other field default
 from __future__ import annotations
 
 import threading
-from typing import Any
+from typing import Any, ClassVar, cast
 
 from orchestra.node import msgdefs, msgspec
 from orchestra.node.exceptions import DeserializationError, ROSException, SerializationError
@@ -34,6 +34,9 @@ class Message:
     _slot_types: list[str] = []
     _fields: tuple[str, ...] = ()
     _spec: MsgSpec | None = None
+    #: generated per class (serialization.compile_codec)
+    _ser: ClassVar[Any]     # (msg, out: bytearray) -> out
+    _deser: ClassVar[Any]   # (buf: bytes, pos) -> (msg, pos)
 
     def __init__(self, *args, **kwargs):
         # genpy's rules and messages: positional values for ALL fields, or keywords for
@@ -60,7 +63,7 @@ class Message:
         pass
 
     # --- wire format -------------------------------------------------------------------
-    def serialize_bytes(self) -> bytearray:
+    def serialize_bytes(self) -> bytes | bytearray:
         """The ROS 1 serialization of this message."""
         out = bytearray()
         try:
@@ -125,7 +128,7 @@ class Message:
     def __ne__(self, other) -> bool:
         return not self == other
 
-    __hash__ = None  # mutable
+    __hash__ = None  # type: ignore[assignment]  # mutable
 
     def __repr__(self) -> str:
         return to_yaml_text(self)
@@ -294,11 +297,11 @@ class Registry:
         for const in spec.constants:
             if const.name not in attrs["_fields"]:
                 attrs[const.name] = const.value
-        cls = type(spec.type.split("/")[1], (Message,), attrs)
+        cls = cast(type[Message], type(spec.type.split("/")[1], (Message,), attrs))
         ser, deser, defaults, _source = compile_codec(cls, spec, nested)
         cls._ser = staticmethod(ser)
         cls._deser = staticmethod(deser)
-        cls._defaults = staticmethod(defaults)
+        cls._defaults = staticmethod(defaults)  # type: ignore[method-assign]
         self._classes[spec.type] = cls
         return cls
 
@@ -437,10 +440,11 @@ def _fill_field(current: Any, value: Any, base: str, array: int | None, path: st
             items = [_fill_field(None, v, base, None, f"{path}[{i}]") for i, v in enumerate(value)]
             return bytes(items) if base in ("uint8", "char") else items
         if base in ("time", "duration"):
-            cls = Time if base == "time" else Duration
-            return [_fill_field(cls(), v, base, None, f"{path}[{i}]") for i, v in enumerate(value)]
-        cls = get_message_class(base) if not isinstance(current, list) or not current else type(current[0])
-        return [fill_message(cls(), v, f"{path}[{i}]") for i, v in enumerate(value)]
+            tcls = Time if base == "time" else Duration
+            return [_fill_field(tcls(), v, base, None, f"{path}[{i}]") for i, v in enumerate(value)]
+        mcls = get_message_class(base) if not isinstance(current, list) or not current \
+            else type(current[0])
+        return [fill_message(mcls(), v, f"{path}[{i}]") for i, v in enumerate(value)]
     if base in ("time", "duration"):
         cls = Time if base == "time" else Duration
         if isinstance(value, dict):
@@ -495,7 +499,8 @@ def fill_message(msg: Message, value: Any, path: str = "") -> Message:
     if msg._type == "std_msgs/Header" and value == "auto":
         # rostopic pub's substitution: a header stamped now (seq is the publisher's, frame_id
         # empty); here also for a whole std_msgs/Header message, which rostopic refuses
-        msg.seq, msg.stamp, msg.frame_id = 0, Time.now(), ""
+        for name, now in (("seq", 0), ("stamp", Time.now()), ("frame_id", "")):
+            setattr(msg, name, now)
         return msg
     if isinstance(value, dict):
         by_name = {f.name: f for f in fields}
