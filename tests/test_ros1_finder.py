@@ -249,3 +249,10 @@ def test_orchestra_run_gives_a_python_script_the_layer(tmp_path):
                          env=env, capture_output=True, text=True, timeout=60)
     assert out.returncode == 0, out.stderr
     assert out.stdout.split() == ["ann", "std_msgs/String"]
+
+
+def test_service_without_separator_is_located(layer):
+    pkg = _package(layer, "l10_nosep", {"srv/S.srv": "int32 a\nint32 b\n"})
+    with pytest.raises(ImportError, match=rf"^{pkg / 'srv' / 'S.srv'}:2: a service definition "
+                                          r"has 1 '---' line between its parts, found 0"):
+        from l10_nosep.srv import S  # noqa: F401

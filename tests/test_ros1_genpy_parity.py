@@ -69,3 +69,41 @@ def test_service_classes_match_genpy(genpy_side, srv_type):
 def test_most_standard_types_are_compared(genpy_side):
     compared = [n for n in MESSAGES if "missing" not in genpy_side[n]]
     assert len(compared) >= 100, f"only {len(compared)} types have a genpy class here"
+
+
+EDGE_CASES = {
+    "l10_edge/Inner.msg": "# an inner type\nduration[] waits\nchar[3] code\nbyte[] signed\n",
+    "l10_edge/Everything.msg": (
+        "# every kind of field and constant\n"
+        "int8 NEG=-5\nuint8 HEX_LIKE=255\nfloat64 PI=3.14159\nstring NOTE= a # kept\n"
+        "bool FLAG=1\nHeader header\nbool[] flags\nint16[4] quad\nfloat32[] values\n"
+        "string[] names\nstring[2] pair\ntime[2] stamps\nInner inner\nInner[2] inners\n"
+        "geometry_msgs/Point[] points\nuint64 big  # trailing comment\nuint8[4] raw\n"),
+}
+
+
+def test_user_definitions_match_genpys_dynamic_classes(tmp_path, monkeypatch, genpy_side):
+    """genpy.dynamic builds classes from a full text, as rostopic does for unknown types: the
+    same definitions must give the same classes here (constants, comments, every array)."""
+    from orchestra.node.msg import Registry
+    from orchestra.packages.index import reset_index
+
+    for rel, text in EDGE_CASES.items():
+        path = tmp_path / rel.split("/")[0] / "msg" / rel.split("/")[1]
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text)
+    (tmp_path / "l10_edge" / "package.xml").write_text(
+        "<package><name>l10_edge</name></package>")
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(tmp_path))
+    reset_index()
+    try:
+        registry = Registry()
+        cls = registry.message_class("l10_edge/Everything")
+        out = subprocess.run([SYSTEM_PYTHON, str(FIXTURES / "populate.py"), "--dynamic"],
+                             input=json.dumps({cls._type: cls._full_text}), capture_output=True,
+                             text=True, timeout=120, env={"PATH": "/usr/bin"})
+        assert out.returncode == 0, out.stderr[-800:]
+        env = dict(OURS, msg=registry.message_class)
+        assert populate.describe(cls, env) == json.loads(out.stdout)[cls._type]
+    finally:
+        reset_index()

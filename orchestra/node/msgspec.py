@@ -179,7 +179,8 @@ def split_sections(text: str, count: int, what: str, source: str | None = None
             start = i + 1
     parts.append(("".join(lines[start:]), start + 1))
     if len(parts) != count:
-        raise MsgSpecError(f"{source or what}: a {what} definition has {count - 1} '---' "
+        raise MsgSpecError(f"{source or what}:{max(len(lines), 1)}: a {what} definition has "
+                           f"{count - 1} '---' "
                            f"line{'s' if count > 2 else ''} between its parts, found "
                            f"{len(parts) - 1}")
     return parts

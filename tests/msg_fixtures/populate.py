@@ -71,7 +71,8 @@ def describe(cls, env: dict) -> dict:
     return {"md5": cls._md5sum, "type": cls._type, "slots": list(cls.__slots__),
             "slot_types": list(cls._slot_types), "has_header": cls._has_header,
             "bytes": data.hex(), "str": str(msg), "str_back": str(back),
-            "default_str": str(cls())}
+            "default_str": str(cls()),
+            "constants": sorted([k, repr(v)] for k, v in vars(cls).items() if k.isupper())}
 
 
 def _genpy_env():
@@ -107,5 +108,20 @@ def main() -> None:
     json.dump(out, sys.stdout)
 
 
+
+
+def dynamic_main() -> None:
+    """stdin: JSON {type: full_text}; stdout: describe() of genpy.dynamic's class for each."""
+    import genpy
+    from genpy.dynamic import generate_dynamic
+
+    out = {}
+    for type_name, full_text in json.load(sys.stdin).items():
+        classes = generate_dynamic(type_name, full_text)
+        env = {"time": genpy.Time, "duration": genpy.Duration, "msg": classes.__getitem__}
+        out[type_name] = describe(classes[type_name], env)
+    json.dump(out, sys.stdout)
+
+
 if __name__ == "__main__":
-    main()
+    dynamic_main() if sys.argv[1:] == ["--dynamic"] else main()
