@@ -94,7 +94,11 @@ def _make_getattr(module: types.ModuleType, pkg: str, kind: str):
             return names
         if attr.startswith("__") or not attr[:1].isalpha():
             raise AttributeError(f"module {module.__name__!r} has no attribute {attr!r}")
-        cls = _load_class(pkg, kind, attr)
+        try:
+            cls = _load_class(pkg, kind, attr)
+        except DefinitionImportError as exc:
+            # the user's definition is at fault: show its file:line, not our frames
+            raise exc.with_traceback(None) from None
         if cls is None:
             raise AttributeError(f"module {module.__name__!r} has no attribute {attr!r} "
                                  f"(no {kind} definition {pkg}/{attr})")
@@ -184,7 +188,10 @@ class PackageModuleFinder(importlib.abc.MetaPathFinder):
         if path is not None or "." in fullname or fullname in _STARTUP_PROBES or _reentrant():
             return None
         with _Working():
-            return self._find(fullname)
+            try:
+                return self._find(fullname)
+            except ModuleNotFoundError as exc:
+                raise exc.with_traceback(None) from None
 
     @staticmethod
     def _find(fullname: str) -> importlib.machinery.ModuleSpec | None:
