@@ -25,13 +25,15 @@ from orchestra.bag.records import (
     Connection,
     Op,
     encode_bag_header,
+    encode_header,
     encode_index,
-    encode_message,
-    encode_record,
     op_field,
+    pack_time,
 )
 
 log = logging.getLogger(__name__)
+
+_IOV_MAX = 1024
 
 #: rosbag record's default chunk size
 DEFAULT_CHUNK_SIZE = 768 * 1024
@@ -43,7 +45,11 @@ class BagWriteError(Exception):
 
 @dataclass
 class _OpenChunk:
-    data: bytearray = field(default_factory=bytearray)
+    """The chunk being filled: its records as a list of pieces (message payloads are kept
+    by reference, not copied into one buffer) and their total length."""
+
+    parts: list = field(default_factory=list)
+    length: int = 0
     start: int = -1
     end: int = 0
     entries: dict[int, list[tuple[int, int]]] = field(default_factory=dict)
@@ -90,7 +96,7 @@ class BagWriter:
     @property
     def size(self) -> int:
         """Bytes on disk plus the open chunk: what splitting by size looks at."""
-        return self._good_end + len(self._chunk.data)
+        return self._good_end + self._chunk.length
 
     def add_connection(self, topic: str, header: dict[str, str]) -> Connection:
         """The connection for ``topic`` with this publisher header (one per distinct
@@ -106,18 +112,26 @@ class BagWriter:
         return conn
 
     def write(self, conn: Connection, stamp: int, data: bytes | memoryview) -> None:
-        """Append one message (``stamp`` in ns); a full chunk goes to disk at once."""
+        """Append one message (``stamp`` in ns); a full chunk goes to disk at once. ``data``
+        is kept by reference until its chunk is written, so it must not change (bytes)."""
         if self.failed is not None:
             raise BagWriteError(f"{self.path}: {self.failed.strerror or self.failed}")
         chunk = self._chunk
         if conn.id not in self._in_file and conn.id not in chunk.entries:
-            chunk.data += conn.encode()
-        chunk.entries.setdefault(conn.id, []).append((stamp, len(chunk.data)))
-        chunk.data += encode_message(conn.id, stamp, data)
+            record = conn.encode()
+            chunk.parts.append(record)
+            chunk.length += len(record)
+        chunk.entries.setdefault(conn.id, []).append((stamp, chunk.length))
+        header = encode_header({**op_field(Op.MSG_DATA), "conn": U32.pack(conn.id),
+                                "time": pack_time(stamp)})
+        prefix = U32.pack(len(header)) + header + U32.pack(len(data))
+        chunk.parts.append(prefix)
+        chunk.parts.append(data)
+        chunk.length += len(prefix) + len(data)
         chunk.start = stamp if chunk.start < 0 else min(chunk.start, stamp)
         chunk.end = max(chunk.end, stamp)
         self.messages += 1
-        if len(chunk.data) >= self.chunk_size:
+        if chunk.length >= self.chunk_size:
             self.flush_chunk()
 
     def flush_chunk(self) -> None:
@@ -125,20 +139,24 @@ class BagWriter:
         chunk = self._chunk
         if not chunk.entries:
             return
-        raw = bytes(chunk.data)
-        body = chunkcodec.compress(self.compression, raw)
-        out = [encode_record({**op_field(Op.CHUNK), "compression": self.compression.encode(),
-                              "size": U32.pack(len(raw))}, body)]
-        out += [encode_index(cid, entries) for cid, entries in chunk.entries.items()]
-        blob = b"".join(out)
+        if self.compression == "none":
+            body = chunk.parts
+            body_len = chunk.length
+        else:
+            packed = chunkcodec.compress(self.compression, b"".join(chunk.parts))
+            body, body_len = [packed], len(packed)
+        header = encode_header({**op_field(Op.CHUNK), "compression": self.compression.encode(),
+                                "size": U32.pack(chunk.length)})
+        parts = [U32.pack(len(header)) + header + U32.pack(body_len), *body,
+                 b"".join(encode_index(cid, entries) for cid, entries in chunk.entries.items())]
         try:
-            self._write(blob)
+            self._write_parts(parts)
         except OSError as exc:
             self._fail(exc)
         self._infos.append(ChunkInfo(self._good_end, chunk.start, chunk.end,
                                      {cid: len(e) for cid, e in chunk.entries.items()}))
         self._in_file.update(chunk.entries)
-        self._good_end += len(blob)
+        self._good_end += sum(len(p) for p in parts)
         self._chunk = _OpenChunk()
 
     def close(self) -> None:
@@ -185,6 +203,20 @@ class BagWriter:
         while view:
             n = os.write(self._fd, view)
             view = view[n:]
+
+    def _write_parts(self, parts: list) -> None:
+        """One gathered write of a chunk's pieces (no joined copy of a large chunk)."""
+        assert self._fd is not None
+        total = sum(len(p) for p in parts)
+        done = 0
+        for start in range(0, len(parts), _IOV_MAX):  # writev takes at most IOV_MAX pieces
+            group = parts[start:start + _IOV_MAX]
+            n = os.writev(self._fd, group)
+            done += n
+            if n < sum(len(p) for p in group):
+                break
+        if done < total:  # a short write: finish the rest (or meet the error) plainly
+            self._write(b"".join(bytes(p) for p in parts)[done:])
 
     def _fail(self, exc: OSError) -> None:
         """A chunk did not fit: cut the partial chunk off, remember why, and stop."""

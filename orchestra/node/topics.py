@@ -31,6 +31,8 @@ if TYPE_CHECKING:
 log = logging.getLogger(__name__)
 
 RECONNECT_MIN = 0.05
+_RECV_MIN = 65536  # receive buffer size of a connection
+_RECV_KEEP = 4 << 20  # a buffer grown past this for one huge message shrinks back after it
 RECONNECT_MAX = 2.0
 
 
@@ -356,28 +358,41 @@ class InConnection:
         sub = self.subscription
         header = self.header
         keep = sub.queue_size
-        buf = bytearray()
-        need = 4
+        # one reusable receive buffer filled in place (recv_into): a large message (an
+        # image) costs no fresh allocation per recv call and no second copy to append it
+        buf = bytearray(_RECV_MIN)
+        filled = 0
         while not self.closed.is_set():
-            chunk = sock.recv(max(need - len(buf), 65536))
-            if not chunk:
+            if filled >= 4:
+                need = 4 + _U32.unpack_from(buf, 0)[0]
+                if need > tcpros.MAX_MESSAGE + 4:
+                    raise TransportException(f"message of {need - 4} bytes refused")
+                if need > len(buf):
+                    buf.extend(bytes(need - len(buf)))
+            with memoryview(buf) as view:
+                n = sock.recv_into(view[filled:])
+            if not n:
                 raise TransportException("connection closed by peer")
-            buf += chunk
-            if len(buf) < need:
-                continue
+            filled += n
             frames: list[bytes] = []
             pos = 0
             with memoryview(buf) as view:
-                while len(buf) - pos >= 4:
+                while filled - pos >= 4:
                     (size,) = _U32.unpack_from(view, pos)
                     if size > tcpros.MAX_MESSAGE:
                         raise TransportException(f"message of {size} bytes refused")
-                    if len(buf) - pos - 4 < size:
+                    if filled - pos - 4 < size:
                         break
                     frames.append(bytes(view[pos + 4:pos + 4 + size]))
                     pos += 4 + size
-            del buf[:pos]
-            need = 4 if len(buf) < 4 else 4 + _U32.unpack_from(buf, 0)[0]
+            if not frames:
+                continue
+            rest = filled - pos
+            if len(buf) > _RECV_KEEP and rest <= _RECV_MIN:
+                buf = bytearray(buf[pos:filled]) + bytearray(_RECV_MIN - rest)
+            else:
+                buf[:rest] = buf[pos:filled]
+            filled = rest
             if keep and len(frames) > keep:
                 self.drops += len(frames) - keep
                 frames = frames[-keep:]
