@@ -121,6 +121,9 @@ class LaunchRun:
         self._thread: threading.Thread | None = None
         self._ended = threading.Event()
         self._closers: list[Callable[[], None]] = []
+        self._lock = threading.Lock()
+        # calls handed to the loop and not answered yet: answered RunEnded when it ends
+        self._pending: set[concurrent.futures.Future[Any]] = set()
 
     # ------------------------------------------------------------------ life cycle
 
@@ -133,13 +136,18 @@ class LaunchRun:
         return self._supervise(install_signals=True)
 
     def start(self) -> LaunchRun:
-        """Set up and start every node; returns at once, the run goes on in a thread."""
+        """Set up and spawn every node; returns then, the run goes on in a thread."""
         if self.supervisor is not None:
             raise RuntimeError("this run was already started")
         self._setup()
         self._thread = threading.Thread(target=self._supervise, args=(False,),
                                         name="orchestra run", daemon=True)
         self._thread.start()
+        # the loop runs this only after start_all: every node has been spawned on return
+        try:
+            self._call(lambda: None)
+        except RunEnded:
+            pass            # nothing to supervise (no nodes, a reused master): already over
         return self
 
     def wait(self, timeout: float | None = None) -> RunReport | None:
@@ -271,16 +279,27 @@ class LaunchRun:
         future: concurrent.futures.Future[T] = concurrent.futures.Future()
 
         def call() -> None:
+            if not future.set_running_or_notify_cancel():
+                return
             try:
                 future.set_result(func())
             except BaseException as exc:  # noqa: BLE001 - handed to the caller
                 future.set_exception(exc)
 
-        supervisor.loop.call_threadsafe(call)
-        done, _ = concurrent.futures.wait([future], timeout=timeout)
+        with self._lock:
+            if self._ended.is_set():
+                raise RunEnded("the run is over")
+            self._pending.add(future)
+        try:
+            supervisor.loop.call_threadsafe(call)
+            done, _ = concurrent.futures.wait([future], timeout=timeout)
+        finally:
+            with self._lock:
+                self._pending.discard(future)
         if not done:
-            raise RunEnded("the run is over") if self._ended.is_set() else TimeoutError(
-                "the supervisor did not answer")
+            raise TimeoutError("the supervisor did not answer")
+        if future.cancelled():
+            raise RunEnded("the run is over")
         return future.result()
 
     def _environ(self) -> dict[str, str]:
@@ -391,7 +410,12 @@ class LaunchRun:
             self._teardown()
             self.report = RunReport(result.exit_code, result.reason, list(result.failed),
                                     {p.spec.name: ProcessInfo.of(p) for p in supervisor.procs})
-            self._ended.set()
+            with self._lock:
+                self._ended.set()
+                pending, self._pending = self._pending, set()
+            for future in pending:        # not run by the loop: the caller gets RunEnded
+                if future.cancel():
+                    future.set_running_or_notify_cancel()   # wakes concurrent.futures.wait
         return self.report
 
     def _teardown(self) -> None:

@@ -31,7 +31,13 @@ from orchestra.errors import OrchestraError
 from orchestra.launch.plan import LaunchPlan, Test
 from orchestra.supervise.command import find_node_executable, ros_home
 from orchestra.supervise.output import Screen
-from orchestra.supervise.reaper import MARK_VARIABLE, child_setup, signal_group
+from orchestra.supervise.reaper import (
+    MARK_VARIABLE,
+    child_setup,
+    marked_pids,
+    new_mark,
+    signal_group,
+)
 from orchestra.supervise.specs import build_specs
 
 Report = Callable[[str], None]
@@ -181,7 +187,10 @@ class TestRunner:
                            self.run_options)[0]
         argv = [*spec.argv, GTEST_FLAG + results_file] + (["--text"] if self.options.text
                                                            else [])
-        env = {**spec.env, MARK_VARIABLE: run.supervisor.mark}   # strays go with the run
+        # its own mark: what the test leaves behind is found and stopped with it (the run's
+        # mark would have the run's stray sweep reap our child under our feet)
+        mark = new_mark()
+        env = {**spec.env, MARK_VARIABLE: mark}
         output: IO[Any] | None = None
         if not self.options.text and run.log_dir:
             output = open(os.path.join(run.log_dir, f"{spec.log_name}-stdout.log"), "ab")
@@ -196,6 +205,7 @@ class TestRunner:
                 return [error_case(name, f"cannot start test [{name}] ({argv[0]}): "
                                          f"{exc.strerror or exc}")]
             why = self._wait(run, proc, test.time_limit)
+            _stop_marked(mark)
         finally:
             if output is not None:
                 output.close()
@@ -220,9 +230,7 @@ class TestRunner:
             threading.Thread(target=target, daemon=True, name="orchestra test wait").start()
         finished = ended.wait(time_limit)
         code = proc.poll()
-        # the run stops by itself only when a required node ended (we stop it afterwards);
-        # its end also sweeps the test (which carries the run's mark), so then the test's
-        # own exit says nothing
+        # the run stops by itself only when a required node ended (we stop it afterwards)
         ending = run.supervisor.result if run.supervisor is not None else None
         why = ""
         if not finished:
@@ -265,6 +273,15 @@ class TestRunner:
         if not cases:
             return [error_case(name, f"{results_file}: contains no test cases")]
         return cases
+
+
+def _stop_marked(mark: str) -> None:
+    """SIGKILL whatever the test left running outside its process group (setsid, daemons)."""
+    for pid in marked_pids(mark):
+        try:
+            os.kill(pid, signal.SIGKILL)
+        except OSError:
+            pass
 
 
 def _where(test: Test) -> str:
