@@ -173,8 +173,9 @@ def test_orchestra_ros1_real_turns_the_layer_off():
 
 def test_a_real_ros_install_is_never_shadowed():
     if not os.path.exists(SYSTEM_PYTHON) or subprocess.run(
-            [SYSTEM_PYTHON, "-c", "import rospy"], capture_output=True).returncode != 0:
-        pytest.skip("no real rospy under /usr/bin/python3 (Debian python3-rospy)")
+            [SYSTEM_PYTHON, "-c", "import rospy, std_msgs.msg"],
+            capture_output=True).returncode != 0:
+        pytest.skip("no real rospy/std_msgs under /usr/bin/python3 (python3-rospy, -std-msgs)")
     out = _run(SYSTEM_PYTHON, "import rospy, std_msgs.msg, sys; print(rospy.__file__); "
                               "print(std_msgs.msg.String.__module__); "
                               f"print({activation.SITE_DIR!r} in sys.path)")
