@@ -257,3 +257,14 @@ def test_service_without_separator_is_located(layer):
     with pytest.raises(ImportError, match=rf"^{pkg / 'srv' / 'S.srv'}:2: a service definition "
                                           r"has 1 '---' line between its parts, found 0"):
         from l10_nosep.srv import S  # noqa: F401
+
+
+def test_unknown_package_of_any_name_is_explained_only_for_msg_imports(layer):
+    import importlib.util
+
+    with pytest.raises(ImportError, match="no ROS package l10_nowhere with msg/"):
+        from l10_nowhere.srv import Thing  # noqa: F401
+    with pytest.raises(ModuleNotFoundError) as plain:
+        import l10_nowhere  # noqa: F401
+    assert "no ROS package" not in str(plain.value)
+    assert importlib.util.find_spec("l10_nowhere") is None

@@ -11,8 +11,9 @@ submodules. Here they are made on import, from ``orchestra.node.msg``'s classes:
 - ``PackageModuleFinder`` (last) answers a top-level ``<pkg>`` that nothing else found: a
   package module whose ``__path__`` is the package's ``src/<pkg>`` (catkin_python_setup's
   layout) when it has one, so ``from my_pkg.utils import x`` keeps working, and whose
-  ``__init__.py`` there is run. A name that is no package at all fails with a
-  ModuleNotFoundError that says where it looked.
+  ``__init__.py`` there is run. ``import pkg.msg`` of a package that does not exist fails
+  with a ModuleNotFoundError that says where it looked (any other missing module keeps
+  Python's own error, so ``importlib.util.find_spec`` probes still get None).
 
 Classes are built on first attribute access (PEP 562 ``__getattr__``): importing
 ``std_msgs.msg`` builds nothing, ``from std_msgs.msg import String`` builds String and its
@@ -180,6 +181,24 @@ def python_source_dir(pkg: str, directory: str) -> str | None:
     return candidate if os.path.isdir(candidate) else None
 
 
+def _importing_definitions_of(pkg: str) -> bool:
+    """Whether this lookup of ``pkg`` is the first step of importing ``pkg.msg``/``pkg.srv``.
+
+    Python imports a parent package before the submodule, so the finder asked for ``pkg``
+    cannot see the dotted name; the import system's own frames above it still hold it.
+    Only a failing lookup pays for this walk."""
+    wanted = {f"{pkg}.{kind}" for kind in KINDS}
+    frame: types.FrameType | None = sys._getframe(1)
+    for _ in range(64):
+        if frame is None:
+            return False
+        if frame.f_code.co_name == "_find_and_load_unlocked" and \
+                frame.f_locals.get("name") in wanted:
+            return True
+        frame = frame.f_back
+    return False
+
+
 class PackageModuleFinder(importlib.abc.MetaPathFinder):
     """A top-level package module for a ROS package nothing else could import."""
 
@@ -199,8 +218,8 @@ class PackageModuleFinder(importlib.abc.MetaPathFinder):
         directory = defs.package_dir(fullname)
         source = python_source_dir(fullname, directory) if directory else None
         if source is None and not defs.has_definitions(fullname):
-            if fullname.endswith(("_msgs", "_srvs")):
-                # most likely a message package: say where we looked
+            if _importing_definitions_of(fullname):
+                # `import pkg.msg` / `from pkg.srv import X`: say where we looked
                 raise ModuleNotFoundError(
                     f"No module named '{fullname}': no ROS package {fullname} with msg/, "
                     f"srv/ or action/ definitions (looked in {defs.where_searched()})",
