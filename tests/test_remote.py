@@ -18,7 +18,12 @@ import pytest
 from orchestra.launch.plan import Machine, Node
 from orchestra.remote import agent, payload, ssh
 from orchestra.remote.locality import UnresolvableAddress, is_local_machine
-from orchestra.remote.session import agent_command, check_machine_config, reachable_master_uri
+from orchestra.remote.session import (
+    CLIENT,
+    agent_command,
+    check_machine_config,
+    reachable_master_uri,
+)
 from orchestra.supervise.command import node_env
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
@@ -32,6 +37,12 @@ def target(**kw) -> ssh.SshTarget:
                   control_path="/tmp/x/c0", config=None)
     values.update(kw)
     return ssh.SshTarget(**values)
+
+
+def test_master_forwards_the_agent_socket_and_fails_if_it_cannot():
+    argv = ssh.master_argv(target(), forward=("/tmp/x/a0", "/tmp/orchestra-agent-1/s"))
+    assert ["-L", "/tmp/x/a0:/tmp/orchestra-agent-1/s"] == argv[argv.index("-L"):][:2]
+    assert "ExitOnForwardFailure=yes" in argv
 
 
 def test_session_argv_is_batch_mode_multiplexed_and_never_reads_the_terminal():
@@ -119,12 +130,12 @@ def test_locality_follows_roslaunch(monkeypatch):
         is_local_machine("robot-base", None)
 
 
-SLOW_STOPPER = r'''
+SLOW_STOPPER = r"""
 import signal, sys, time
-print("up", flush=True)
 signal.signal(signal.SIGINT, lambda *a: (print("got SIGINT", flush=True), sys.exit(0)))
+print("up", flush=True)
 time.sleep(60)
-'''
+"""
 
 
 @pytest.fixture
@@ -144,28 +155,60 @@ def package(tmp_path, monkeypatch):
     return tmp_path
 
 
-def test_agent_runs_the_node_and_stops_it_when_its_channel_closes(package):
-    node = Node("adem", "stopper", "s", args="x")
-    data = {"node": payload.node_to_data(node), "machine": "m", "address": "10.0.0.2",
-            "master_uri": "http://10.0.0.1:11311/", "run_id": "r1", "log_name": "s-1",
-            "mark": None, "sigint_timeout": 5, "sigterm_timeout": 1}
-    proc = subprocess.Popen([sys.executable, "-m", "orchestra.remote.agent", "run",
+def start_agent(nodes, tmp_path):
+    """The agent as ssh would run it (stdout = its channel); returns (process, its report)."""
+    sock = f"/tmp/orchestra-agent-test-{os.getpid()}-{os.urandom(3).hex()}/s"
+    data = {"machine": "m", "address": "10.0.0.2", "mark": None, "socket": sock,
+            "nodes": [payload.node_to_data(n) for n in nodes]}
+    proc = subprocess.Popen([sys.executable, "-m", "orchestra.remote.agent", "serve",
                              payload.encode(data)], stdin=subprocess.DEVNULL,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-    assert proc.stdout.readline() == b"up\n"                  # relayed over the "channel"
-    log = package / "log" / "r1" / "s-1-stdout.log"
-    proc.stdout.close()                                      # the ssh channel goes away
-    assert proc.wait(timeout=10) == 0                        # node stopped by SIGINT, exit 0
-    wait_for(lambda: b"got SIGINT" in log.read_bytes())      # ...kept in the remote log
-    assert log.read_bytes().startswith(b"up\n")
+    return proc, json.loads(proc.stdout.readline()), sock
 
 
-def test_agent_check_reports_missing_executables_as_json(package):
-    data = {"nodes": [payload.node_to_data(Node("adem", "stopper", "a")),
-                      payload.node_to_data(Node("adem", "nothere", "b", filename="f", line=2))]}
-    out = subprocess.run([sys.executable, "-m", "orchestra.remote.agent", "check",
-                          payload.encode(data)], capture_output=True, text=True, timeout=30)
-    report = json.loads(out.stdout)
+def test_agent_runs_the_node_through_the_client_and_stops_it_when_the_client_dies(package):
+    node = Node("adem", "stopper", "s", args="x")
+    agent_proc, report, sock = start_agent([node], package)
+    assert report["missing"] == []
+    data = {"node": payload.node_to_data(node), "master_uri": "http://10.0.0.1:11311/",
+            "run_id": "r1", "log_name": "s-1", "sigint_timeout": 5, "sigterm_timeout": 1}
+    client = subprocess.Popen([sys.executable, "-I", "-S", CLIENT, sock, payload.encode(data)],
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    try:
+        assert client.stdout.readline() == b"up\n"              # relayed by the agent
+        log = package / "log" / "r1" / "s-1-stdout.log"
+        client.send_signal(signal.SIGINT)                       # the supervisor's stop
+        assert client.wait(timeout=10) == -signal.SIGINT
+        wait_for(lambda: b"got SIGINT" in log.read_bytes())     # the node stopped in order,
+        assert log.read_bytes().startswith(b"up\n")             # ...its output kept there
+    finally:
+        agent_proc.stdout.close()                               # the agent's session ends
+        assert agent_proc.wait(timeout=10) == 0
+    assert not os.path.exists(os.path.dirname(sock))
+
+
+def test_node_exit_status_reaches_the_client(package):
+    node = Node("adem", "stopper", "s")
+    (package / "ws" / "adem" / "three").write_text(f"#!{sys.executable}\nimport sys\n"
+                                                    "print('bye'); sys.exit(3)\n")
+    (package / "ws" / "adem" / "three").chmod(0o755)
+    three = Node("adem", "three", "t")
+    agent_proc, _, sock = start_agent([node, three], package)
+    data = {"node": payload.node_to_data(three), "master_uri": "u", "run_id": "r2",
+            "log_name": "t-1", "sigint_timeout": 5, "sigterm_timeout": 1}
+    try:
+        done = subprocess.run([sys.executable, "-I", "-S", CLIENT, sock, payload.encode(data)],
+                              capture_output=True, timeout=30)
+        assert (done.returncode, done.stdout) == (3, b"bye\n")
+    finally:
+        agent_proc.stdout.close()
+        agent_proc.wait(timeout=10)
+
+
+def test_agent_reports_missing_executables_before_anything_runs(package):
+    proc, report, _ = start_agent([Node("adem", "stopper", "a"),
+                                   Node("adem", "nothere", "b", filename="f", line=2)], package)
+    assert proc.wait(timeout=10) == 0
     assert len(report["missing"]) == 1 and "nothere" in report["missing"][0]
 
 

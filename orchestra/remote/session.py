@@ -1,33 +1,43 @@
-"""The launching host's side of remote machines: connections, the preflight, node commands.
+"""The launching host's side of remote machines: connections, agents, node commands.
 
 Order of a run with remote nodes (all-or-nothing, like local nodes):
 
-1. ``RemoteSession.open`` -- before the master or any process starts: one ``ssh -M -N``
-   master connection per machine, all at once, each waited for (its control socket appears)
-   up to the machine's ``timeout``; then, over those connections and also all at once, one
-   ``agent check`` per machine, which runs the machine's env-loader and finds every node's
-   executable there. Any failure (host key, refused key, wrong port, env-loader missing,
-   orchestra or a package missing) is one error naming the machine, its address and what
-   ssh or the agent said; the masters are closed and nothing else was started.
-2. ``node_argv`` -- each remote node's local process is ``ssh ... -- env ROS_MASTER_URI=URI
-   [ENV_LOADER] python3 -m orchestra.remote.agent run PAYLOAD`` multiplexed on its machine's
-   master; the supervisor runs it like any node (respawn, required, output, stop).
+1. ``RemoteSession.open`` -- before the master or any process starts: the ``ssh -M -N``
+   master connections of every machine, all at once, each waited for (its control socket
+   appears) up to the machine's ``timeout``; then, over them and also all at once, one agent
+   per machine (``env ROS_MASTER_URI=URI [ENV_LOADER] python3 -m orchestra.remote.agent
+   serve``), which first finds every node's executable there and answers with one JSON line.
+   Any failure (host key, refused key, wrong port, env-loader missing, orchestra or a package
+   missing) is one error naming the machine, its address and what ssh or the agent said; all
+   connections are closed and nothing else was started.
+2. ``node_argv`` -- each remote node's local process is ``client.py`` (a bare interpreter,
+   standard library only) connected to a local Unix socket that the machine's master
+   connection forwards (``-L local:remote``) to the agent's socket: one forwarded channel per
+   node, no remote shell or ssh session per node. The supervisor runs it like any node
+   (respawn, required, output, stop).
 3. ``close`` -- after the supervisor is done: one ``agent reap`` per machine waits (bounded
-   by the longest stop timeouts) until no process of the run is left there, then the master
-   connections are closed.
+   by the longest stop timeouts) until no process of the run is left there; then the agents'
+   sessions and the connections are closed.
 
-The masters get the parent-death signal like nodes do and are registered with the watchdog,
-so a SIGKILLed orchestra drops every connection, and every agent stops its node.
+A machine costs one connection and two ssh sessions (the agent's and, at the end, ``reap``),
+whatever its number of nodes: forwarded channels are not sessions (sshd's ``MaxSessions``,
+10 by default, does not limit them), and a remote login shell -- which often sources ROS
+setup files from ``.bashrc`` -- runs once per machine, not once per node. The masters and
+agent sessions get the parent-death signal like nodes and are registered with the watchdog,
+so a SIGKILLed orchestra drops every connection and every agent stops its nodes.
 """
 from __future__ import annotations
 
 import json
 import logging
 import os
+import secrets
+import select
 import shlex
 import shutil
 import socket
 import subprocess
+import sys
 import tempfile
 import time
 import urllib.parse
@@ -42,6 +52,7 @@ from orchestra.supervise.reaper import setpriv_prefix
 logger = logging.getLogger(__name__)
 
 AGENT = ("python3", "-m", "orchestra.remote.agent")
+CLIENT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "client.py")
 
 
 class RemoteError(OrchestraError):
@@ -86,7 +97,7 @@ def reachable_master_uri(master_uri: str, address: str) -> str:
 
 
 def agent_command(machine: Machine, master_uri: str, mode: str, data: dict) -> str:
-    """The remote command line: roslaunch's ``env ROS_MASTER_URI=.. ENV_LOADER cmd`` shape."""
+    """The agent's command line: roslaunch's ``env ROS_MASTER_URI=.. ENV_LOADER cmd`` shape."""
     words = ["env", f"ROS_MASTER_URI={master_uri}"]
     if machine.env_loader:
         words.append(machine.env_loader)
@@ -95,16 +106,20 @@ def agent_command(machine: Machine, master_uri: str, mode: str, data: dict) -> s
 
 
 @dataclass
-class _Connection:
+class _Machine:
+    """One remote machine of the run: its connection, its agent and their sockets."""
+
     machine: Machine
     target: ssh.SshTarget
     first_node: Node
-    popen: subprocess.Popen | None = None
-    stderr_path: str = ""
+    local_socket: str            # this host's end of the forwarding
+    remote_socket: str           # the agent's socket on the machine
+    master: subprocess.Popen | None = None
+    agent: subprocess.Popen | None = None
 
 
 class RemoteSession:
-    """The remote machines of one run: their connections and their nodes' commands."""
+    """The remote machines of one run: their connections, agents and nodes' commands."""
 
     def __init__(self, machines: dict[str, Machine], nodes: Sequence[Node],
                  mark: str | None = None, watch: Callable[[int], None] | None = None):
@@ -113,132 +128,136 @@ class RemoteSession:
         self.nodes = list(nodes)
         self.program = ssh.ssh_program()
         self.dir = tempfile.mkdtemp(prefix="orchestra-ssh-")
-        self.connections: dict[str, _Connection] = {}
+        self.machines: dict[str, _Machine] = {}
+        token = secrets.token_hex(8)
         for node in self.nodes:
             machine = machines[node.machine_name or ""]
             check_machine_config(machine, node)
-            if machine.name not in self.connections:
-                control = os.path.join(self.dir, f"c{len(self.connections)}")
-                self.connections[machine.name] = _Connection(
-                    machine, ssh.target_for(machine, control), node)
+            if machine.name not in self.machines:
+                number = len(self.machines)
+                self.machines[machine.name] = _Machine(
+                    machine, ssh.target_for(machine, os.path.join(self.dir, f"c{number}")),
+                    node, local_socket=os.path.join(self.dir, f"a{number}"),
+                    remote_socket=f"/tmp/orchestra-agent-{token}-{number}/s")
         self.max_stop = 0.0
 
     # ------------------------------------------------------------------ before the run
 
-    def open(self, master_uri: str = "http://localhost:11311/") -> None:
-        """Connect every machine and check it can run its nodes; RemoteError if not."""
+    def open(self) -> None:
+        """Connect every machine and start its agent; RemoteError if any cannot run its nodes."""
         try:
             self._start_masters()
             self._wait_masters()
-            self._check_machines(master_uri)
+            self._start_agents()
         except BaseException:
             self.close(reap=False)
             raise
 
+    def _spawn(self, argv: list[str], **kwargs) -> subprocess.Popen:
+        """A helper process that dies with orchestra (parent-death signal + watchdog)."""
+        popen = subprocess.Popen([*(setpriv_prefix() or ()), *argv], start_new_session=True,
+                                 stdin=subprocess.DEVNULL, **kwargs)
+        if self.watch is not None:
+            self.watch(popen.pid)
+        return popen
+
     def _start_masters(self) -> None:
-        prefix = list(setpriv_prefix() or ())
-        for conn in self.connections.values():
-            conn.stderr_path = conn.target.control_path + ".err"
-            with open(conn.stderr_path, "wb") as err:
-                conn.popen = subprocess.Popen(
-                    [*prefix, *ssh.master_argv(conn.target, self.program)],
-                    stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=err,
-                    start_new_session=True)
-            if self.watch is not None:
-                self.watch(conn.popen.pid)
+        for entry in self.machines.values():
+            argv = ssh.master_argv(entry.target, self.program,
+                                   forward=(entry.local_socket, entry.remote_socket))
+            with open(entry.target.control_path + ".err", "wb") as err:
+                entry.master = self._spawn(argv, stdout=subprocess.DEVNULL, stderr=err)
 
     def _wait_masters(self) -> None:
         """Until every control socket exists; the first master that exits is the error."""
         start = time.monotonic()
-        waiting = dict(self.connections)
+        waiting = list(self.machines.values())
         while waiting:
-            for name, conn in list(waiting.items()):
-                assert conn.popen is not None
-                if os.path.exists(conn.target.control_path):
-                    del waiting[name]
-                elif conn.popen.poll() is not None:
-                    raise self._failure(conn, ssh.explain(self._stderr(conn)))
-                elif time.monotonic() - start > conn.machine.timeout + 1.0:
-                    raise self._failure(conn, f"ssh: no connection within the machine's "
-                                              f"timeout ({conn.machine.timeout:g} s)")
+            for entry in list(waiting):
+                assert entry.master is not None
+                control = entry.target.control_path
+                if os.path.exists(control):
+                    waiting.remove(entry)
+                elif entry.master.poll() is not None:
+                    raise self._failure(entry, ssh.explain(_read(control + ".err")))
+                elif time.monotonic() - start > entry.machine.timeout + 1.0:
+                    raise self._failure(entry, f"ssh: no connection within the machine's "
+                                               f"timeout ({entry.machine.timeout:g} s)")
             if waiting:
                 time.sleep(0.01)
 
-    def _stderr(self, conn: _Connection) -> str:
-        try:
-            with open(conn.stderr_path, encoding="utf-8", errors="replace") as fh:
-                return fh.read()
-        except OSError:
-            return ""
+    def _failure(self, entry: _Machine, what: str) -> RemoteError:
+        return RemoteError(f"{entry.target.label}: {what}", _location(entry.first_node))
 
-    def _failure(self, conn: _Connection, what: str) -> RemoteError:
-        return RemoteError(f"{conn.target.label}: {what}", _location(conn.first_node))
-
-    def _check_machines(self, master_uri: str) -> None:
-        running = {}
-        for name, conn in self.connections.items():
-            nodes = [payload.node_to_data(n) for n in self.nodes
-                     if (n.machine_name or "") == name]
-            command = agent_command(conn.machine, master_uri, "check", {"nodes": nodes})
-            running[name] = subprocess.Popen(
-                ssh.session_argv(conn.target, command, self.program),
-                stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-        problems: list[RemoteError] = []
-        for name, proc in running.items():
-            conn = self.connections[name]
-            try:
-                out, err = proc.communicate(timeout=conn.machine.timeout + 30.0)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                out, err = proc.communicate()
-            problem = self._check_result(conn, proc.returncode, out.decode(errors="replace"),
-                                         err.decode(errors="replace"))
-            if problem is not None:
-                problems.append(problem)
+    def _start_agents(self) -> None:
+        for name, entry in self.machines.items():
+            nodes = [payload.node_to_data(n) for n in self.nodes if (n.machine_name or "") == name]
+            data = {"machine": name, "address": entry.machine.address, "mark": self.mark,
+                    "nodes": nodes, "socket": entry.remote_socket}
+            command = agent_command(entry.machine, "http://localhost:11311/", "serve", data)
+            entry.agent = self._spawn(ssh.session_argv(entry.target, command, self.program),
+                                      stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+        problems = [problem for problem in (self._agent_ready(entry)
+                                            for entry in self.machines.values()) if problem]
         if problems:
             raise problems[0]
 
-    def _check_result(self, conn: _Connection, code: int | None, out: str,
-                      err: str) -> RemoteError | None:
-        loader = conn.machine.env_loader
+    def _agent_ready(self, entry: _Machine) -> RemoteError | None:
+        """Read the agent's first line (bounded); a failure is explained from its stderr."""
+        agent = entry.agent
+        assert agent is not None and agent.stdout is not None
+        deadline = time.monotonic() + entry.machine.timeout + 30.0
+        line = b""
+        while not line.endswith(b"\n") and time.monotonic() < deadline:
+            ready, _, _ = select.select([agent.stdout], [], [], deadline - time.monotonic())
+            if not ready:
+                break
+            chunk = os.read(agent.stdout.fileno(), 65536)
+            if not chunk:
+                break
+            line += chunk
+        if line.endswith(b"\n"):
+            try:
+                report = json.loads(line)
+            except ValueError:
+                report = None
+            if isinstance(report, dict):
+                missing = report.get("missing") or []
+                if missing:
+                    more = f" (and {len(missing) - 1} more)" if len(missing) > 1 else ""
+                    return self._failure(entry, f"{missing[0]}{more}")
+                return None
+        if agent.poll() is None:
+            agent.kill()
+        _, err = agent.communicate()
+        return self._agent_failure(entry, agent.returncode, err.decode(errors="replace"))
+
+    def _agent_failure(self, entry: _Machine, code: int | None, err: str) -> RemoteError:
+        loader = entry.machine.env_loader
         if code == 255:
-            return self._failure(conn, ssh.explain(err))
+            return self._failure(entry, ssh.explain(err))
         if code in (126, 127) and loader and loader in err:
-            return self._failure(conn, f"env-loader {loader}: {ssh.last_line(err)}")
+            return self._failure(entry, f"env-loader {loader}: {ssh.last_line(err)}")
         if "No module named" in err or code == 127:
-            return self._failure(conn, "orchestra is not installed there (python3 -m "
-                                       f"orchestra.remote.agent: {ssh.last_line(err)}); install "
-                                       "it, or make the machine's env-loader put it on the "
-                                       "path")
-        try:
-            report = json.loads(out.strip().splitlines()[-1])
-        except (ValueError, IndexError):
-            return self._failure(conn, f"the remote check failed (exit code {code}): "
-                                       f"{ssh.last_line(err)}")
-        missing = report.get("missing") or []
-        if missing:
-            more = f" (and {len(missing) - 1} more)" if len(missing) > 1 else ""
-            return self._failure(conn, f"{missing[0]}{more}")
-        return None
+            return self._failure(entry, "orchestra is not installed there (python3 -m "
+                                        f"orchestra.remote.agent: {ssh.last_line(err)}); "
+                                        "install it, or make the machine's env-loader put it "
+                                        "on the path")
+        return self._failure(entry, f"the remote agent failed (exit code {code}): "
+                                    f"{ssh.last_line(err)}")
 
     # ------------------------------------------------------------------ the run
 
     def node_argv(self, node: Node, master_uri: str, run_id: str, log_name: str,
                   sigint_timeout: float, sigterm_timeout: float) -> list[str]:
-        """The local command of a remote node: a multiplexed ssh session running the agent."""
-        conn = self.connections[node.machine_name or ""]
-        uri = reachable_master_uri(master_uri, conn.machine.address)
+        """The local command of a remote node: client.py on the machine's forwarded socket."""
+        entry = self.machines[node.machine_name or ""]
+        uri = reachable_master_uri(master_uri, entry.machine.address)
         self.max_stop = max(self.max_stop, sigint_timeout + sigterm_timeout)
-        data = {"node": payload.node_to_data(node), "machine": conn.machine.name,
-                "address": conn.machine.address, "master_uri": uri, "run_id": run_id,
-                "log_name": log_name, "mark": self.mark,
-                "sigint_timeout": sigint_timeout, "sigterm_timeout": sigterm_timeout}
-        return ssh.session_argv(conn.target, agent_command(conn.machine, uri, "run", data),
-                                self.program)
-
-    def master_uri_for(self, node: Node, master_uri: str) -> str:
-        return reachable_master_uri(master_uri,
-                                    self.connections[node.machine_name or ""].machine.address)
+        data = {"node": payload.node_to_data(node), "master_uri": uri, "run_id": run_id,
+                "log_name": log_name, "sigint_timeout": sigint_timeout,
+                "sigterm_timeout": sigterm_timeout}
+        return [sys.executable, "-I", "-S", CLIENT, entry.local_socket, payload.encode(data)]
 
     # ------------------------------------------------------------------ after the run
 
@@ -246,37 +265,38 @@ class RemoteSession:
         """Wait until nothing of the run is left remotely (bounded), then disconnect."""
         if reap and self.mark:
             self._reap()
-        for conn in self.connections.values():
-            if conn.popen is not None and conn.popen.poll() is None:
-                conn.popen.terminate()
-        for conn in self.connections.values():
-            if conn.popen is not None:
-                try:
-                    conn.popen.wait(timeout=5.0)
-                except subprocess.TimeoutExpired:
-                    conn.popen.kill()
-                    conn.popen.wait()
+        helpers = [p for entry in self.machines.values() for p in (entry.agent, entry.master)
+                   if p is not None]
+        for popen in helpers:
+            if popen.poll() is None:
+                popen.terminate()
+        for popen in helpers:
+            try:
+                popen.communicate(timeout=5.0)
+            except subprocess.TimeoutExpired:
+                popen.kill()
+                popen.communicate()
         shutil.rmtree(self.dir, ignore_errors=True)
 
     def _reap(self) -> None:
         running = []
-        for conn in self.connections.values():
-            if conn.popen is None or conn.popen.poll() is not None:
+        for entry in self.machines.values():
+            if entry.master is None or entry.master.poll() is not None:
                 continue
-            command = agent_command(conn.machine, "http://localhost:11311/", "reap",
+            command = agent_command(entry.machine, "http://localhost:11311/", "reap",
                                     {"mark": self.mark, "timeout": self.max_stop + 1.0})
-            running.append((conn, subprocess.Popen(
-                ssh.session_argv(conn.target, command, self.program),
+            running.append((entry, subprocess.Popen(
+                ssh.session_argv(entry.target, command, self.program),
                 stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE)))
-        for conn, proc in running:
+        for entry, proc in running:
             try:
-                out, err = proc.communicate(timeout=self.max_stop + conn.machine.timeout + 5)
+                out, err = proc.communicate(timeout=self.max_stop + entry.machine.timeout + 5)
             except subprocess.TimeoutExpired:
                 proc.kill()
                 out, err = proc.communicate()
             if proc.returncode != 0:
                 logger.warning("%s: could not check for leftover processes: %s",
-                               conn.target.label, ssh.explain(err.decode(errors="replace")))
+                               entry.target.label, ssh.explain(err.decode(errors="replace")))
                 continue
             try:
                 killed = json.loads(out.decode().strip().splitlines()[-1]).get("killed")
@@ -284,4 +304,12 @@ class RemoteSession:
                 killed = None
             if killed:
                 logger.warning("%s: killed %d leftover process(es) of this run",
-                               conn.target.label, len(killed))
+                               entry.target.label, len(killed))
+
+
+def _read(path: str) -> str:
+    try:
+        with open(path, encoding="utf-8", errors="replace") as fh:
+            return fh.read()
+    except OSError:
+        return ""

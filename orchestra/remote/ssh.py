@@ -74,15 +74,19 @@ def common_options(target: SshTarget) -> list[str]:
     return options
 
 
-def master_argv(target: SshTarget, program: str = "ssh") -> list[str]:
+def master_argv(target: SshTarget, program: str = "ssh",
+                forward: tuple[str, str] | None = None) -> list[str]:
     """The connection every session of this machine multiplexes on (no command, no stdin).
 
-    ServerAlive* make a dead network visible within ~15 s: the master then exits, every
-    session's channel closes, and the remote agents stop their nodes.
+    ``forward`` = (local socket, remote socket): a Unix-socket forwarding on it, failing the
+    connection if it cannot be set up. ServerAlive* make a dead network visible within ~15 s:
+    the master then exits, every channel closes, and the remote agent stops its nodes.
     """
+    extra = ["-o", "ExitOnForwardFailure=yes", "-L", f"{forward[0]}:{forward[1]}"] \
+        if forward else []
     return [program, *common_options(target), "-M", "-N", "-n", "-T",
             "-o", "ControlPersist=no", "-o", "ServerAliveInterval=5",
-            "-o", "ServerAliveCountMax=3", "--", target.address]
+            "-o", "ServerAliveCountMax=3", *extra, "--", target.address]
 
 
 def session_argv(target: SshTarget, command: str, program: str = "ssh") -> list[str]:

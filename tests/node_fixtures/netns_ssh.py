@@ -106,7 +106,7 @@ class Testbed:
             f"AuthorizedKeysFile {self.ssh_dir / 'authorized_keys'}\n"
             "PermitRootLogin prohibit-password\nPasswordAuthentication no\n"
             "KbdInteractiveAuthentication no\nUsePAM no\nStrictModes no\nPidFile none\n"
-            "MaxSessions 200\nMaxStartups 200\nLogLevel ERROR\nAcceptEnv none\n")
+            "LogLevel ERROR\n")
         self.write_client_config()
 
     def write_client_config(self, key: Path | None = None,
