@@ -72,7 +72,7 @@ def _definitions():
 def _load_class(pkg: str, kind: str, name: str) -> Any:
     """The class for ``pkg/name``, or None when there is no such definition."""
     from orchestra.node import msg
-    from orchestra.node.exceptions import ROSException
+    from orchestra.node.msgspec import MsgSpecError
 
     type_name = f"{pkg}/{name}"
     try:
@@ -81,7 +81,7 @@ def _load_class(pkg: str, kind: str, name: str) -> Any:
         return msg.get_service_class(type_name)
     except msg.MessageNotFound:
         return None
-    except ROSException as exc:   # MsgSpecError: a broken definition, located
+    except MsgSpecError as exc:   # a broken definition, located at its file:line
         raise DefinitionImportError(str(exc), name=f"{pkg}.{kind}") from None
 
 
@@ -112,7 +112,8 @@ def _make_getattr(module: types.ModuleType, pkg: str, kind: str):
     return __getattr__
 
 
-def _srv_part(pkg: str, attr: str) -> tuple[str, str] | None:
+def _srv_part(attr: str) -> tuple[str, str] | None:
+    """``("AddTwoInts", "Request")`` for ``AddTwoIntsRequest``."""
     for suffix in ("Request", "Response"):
         if attr.endswith(suffix) and len(attr) > len(suffix):
             return attr[: -len(suffix)], suffix
@@ -136,7 +137,7 @@ class _MessageModuleLoader(importlib.abc.Loader):
                 try:
                     return plain(attr)
                 except AttributeError:
-                    part = _srv_part(pkg, attr)
+                    part = _srv_part(attr)
                     if part is None:
                         raise
                     service = plain(part[0])
