@@ -136,3 +136,15 @@ def test_importing_orchestra_does_not_import_the_app_layer():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True).stdout
     assert out.strip() == "False"
+
+
+def test_eight_fixture_runs_in_parallel_under_xdist_do_not_collide(tmp_path):
+    """Eight turtlesim runs at once, one per xdist worker: own masters, run ids, ROS_HOMEs."""
+    pytest.importorskip("xdist")
+    cases = HERE / "app_files" / "xdist_sim_cases.py"
+    proc = subprocess.run([sys.executable, "-m", "pytest", "-q", "-n", "8", "-p",
+                           "no:cacheprovider", "--basetemp", str(tmp_path / "base"),
+                           str(cases)], cwd=HERE.parent, capture_output=True, text=True,
+                          timeout=300, stdin=subprocess.DEVNULL)
+    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
+    assert "8 passed" in proc.stdout
