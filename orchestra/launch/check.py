@@ -30,71 +30,24 @@ from typing import Any
 import networkx
 
 from orchestra.errors import Location, OrchestraError
-from orchestra.launch import evaluate, substitution
+from orchestra.launch import evaluate, frontends, rules, substitution
+from orchestra.launch.context import Scope
 from orchestra.launch.entity import Entity
+from orchestra.launch.interpreter import Interpreter, LoadOptions
+from orchestra.launch.plan import Machine
+from orchestra.launch.rules import LaunchError
 
 log = logging.getLogger(__name__)
 
 ERROR = "error"
 WARNING = "warning"
 
-_CONDITION = frozenset({"if", "unless"})
-
-
-def _tag_rules() -> tuple[dict[str, frozenset[str]], dict[str, tuple[str, ...]]]:
-    """Attributes per tag and children per parent, from the interpreter's own tag rules.
-
-    The attribute sets are the interpreter's (it warns about anything else, as roslaunch
-    does); only what the interpreter expresses as code rather than data is spelled out here:
-    which tags may hold which children.
-    """
-    from orchestra.launch import interpreter as rules
-
-    attributes = {
-        "launch": frozenset({"deprecated"}),
-        "node": frozenset(rules.NODE_ATTRS),
-        "test": frozenset(rules.TEST_ATTRS),
-        "machine": frozenset(rules.MACHINE_ATTRS),
-        "param": frozenset(rules.PARAM_ATTRS),
-        "rosparam": frozenset(rules.ROSPARAM_ATTRS),
-        "arg": frozenset(rules.ARG_ATTRS),
-        "include": frozenset(rules.INCLUDE_ATTRS),
-        "group": frozenset(rules.GROUP_ATTRS),
-        "remap": frozenset(rules.REMAP_ATTRS),
-        "env": frozenset(rules.ENV_ATTRS),
-        "master": frozenset({"auto"}),  # defunct; roslaunch ignores it with a warning
-    }
-    attributes = {tag: names | _CONDITION for tag, names in attributes.items()}
-    scope_children = tuple(sorted(rules._TAGS))  # the tags a launch/group body dispatches
-    children = {
-        "launch": scope_children,
-        "group": scope_children,
-        "include": ("arg", "env"),
-        "node": ("param", "rosparam", "remap", "env"),
-        "test": ("param", "rosparam", "remap", "env"),
-    }
-    return attributes, children
-
-
-# Attributes without which the interpreter rejects an element. The interpreter states these
-# in code (``_req``), not as data; repeated here so that elements in branches the args do not
-# take, which the interpreter never reaches, are checked too.
-REQUIRED_ATTRIBUTES: dict[str, tuple[str, ...]] = {
-    "node": ("pkg", "type", "name"),
-    "test": ("pkg", "type", "test-name"),
-    "param": ("name",),
-    "remap": ("from", "to"),
-    "include": ("file",),
-    "arg": ("name",),
-    "env": ("name", "value"),
-    "machine": ("name", "address"),
-}
-
 # Static findings the interpreter also raises when it reaches the element: an interpreter
-# error on the same line as one of these is the same problem, already reported with its column.
+# error about an element that already has one of these is the same problem, already reported.
 _ALSO_FOUND_BY_INTERPRETER = frozenset({
     "syntax", "missing-package", "missing-file", "include-cycle", "respawn-required",
-    "if-unless", "bad-substitution", "missing-attribute", "undeclared-arg",
+    rules.IF_UNLESS, "bad-substitution", rules.MISSING_ATTRIBUTE, "undeclared-arg",
+    rules.BAD_VALUE, rules.FORBIDDEN_ATTRIBUTE,
 })
 
 # Names an ``$(eval ...)`` expression may use that are not args.
@@ -143,74 +96,6 @@ class Report:
                                                     p.location.column or 0, p.code))
 
 
-# ----------------------------------------------------------------------------- locations
-
-
-class _Sources:
-    """File text, read once, to give XML Entities (line only, from lxml) their columns."""
-
-    def __init__(self) -> None:
-        self._lines: dict[str, list[str]] = {}
-
-    def lines(self, path: str) -> list[str]:
-        if path not in self._lines:
-            try:
-                with open(path, encoding="utf-8", errors="replace") as fh:
-                    self._lines[path] = fh.read().splitlines()
-            except OSError:
-                self._lines[path] = []
-        return self._lines[path]
-
-    def locate(self, entity: Entity, attribute: str | None = None) -> Location:
-        """Where ``entity`` (or its ``attribute``) is written, as precisely as known."""
-        recorded = getattr(entity, "attribute_locations", None)
-        if attribute and recorded and attribute in recorded:
-            return recorded[attribute]
-        where = entity.location
-        if where.line is None or where.column is not None:
-            return where
-        lines = self.lines(where.file)
-        row = where.line - 1
-        if not 0 <= row < len(lines):
-            return where
-        # lxml may give the line where a multi-line start tag *ends*: look back for its start
-        for back in range(0, min(row, 30) + 1):
-            start = _find_tag(lines[row - back], entity.tag)
-            if start >= 0:
-                row -= back
-                where = Location(where.file, row + 1)
-                break
-        else:
-            return where
-        if attribute:
-            # the attribute may be on a later line of a multi-line start tag
-            for offset in range(0, 20):
-                if row + offset >= len(lines):
-                    break
-                text = lines[row + offset]
-                begin = start if offset == 0 else 0
-                for quote in ('="', "='", "= ", "="):
-                    col = text.find(f"{attribute}{quote}", begin)
-                    if col > 0 and not (text[col - 1].isalnum() or text[col - 1] in "_-"):
-                        return Location(where.file, where.line + offset, col + 1)
-                if ">" in text[begin:]:
-                    break
-        return Location(where.file, where.line, start + 1)
-
-
-def _find_tag(line: str, tag: str) -> int:
-    """Column (0-based) of ``<tag`` as a whole tag name in ``line``, or -1."""
-    begin = 0
-    while True:
-        col = line.find("<" + tag, begin)
-        if col < 0:
-            return -1
-        after = line[col + 1 + len(tag):col + 2 + len(tag)]
-        if not after or after in " \t/>":
-            return col
-        begin = col + 1
-
-
 # --------------------------------------------------------------------------- static scope
 
 
@@ -235,15 +120,6 @@ def _try_resolve(value: str | None, scope: _StaticScope) -> str | None:
         return None
 
 
-def _is_true(text: str) -> bool | None:
-    lowered = text.strip().lower()
-    if lowered in ("true", "1"):
-        return True
-    if lowered in ("false", "0"):
-        return False
-    return None
-
-
 def _branch_taken(entity: Entity, scope: _StaticScope) -> bool | None:
     """False when the element's if/unless resolves to "not taken"; None when unknown."""
     for name, want in (("if", True), ("unless", False)):
@@ -253,7 +129,7 @@ def _branch_taken(entity: Entity, scope: _StaticScope) -> bool | None:
         value = _try_resolve(raw, scope)
         if value is None:
             return None
-        truth = _is_true(value)
+        truth = rules.truth(entity.tag, name, value)
         if truth is None:
             return None
         if truth != want:
@@ -268,16 +144,16 @@ def _arg_references(value: str) -> Iterator[str]:
     """Names of args that ``value`` reads: ``$(arg x)``, and args named inside ``$(eval)``."""
     if "$" not in value:
         return
-    stripped = value.strip()
-    if stripped.startswith("$(eval ") and stripped.endswith(")"):
-        yield from _eval_references(stripped[7:-1])
+    expression = substitution.eval_expression(value)
+    if expression is not None:
+        yield from _eval_references(expression)
         return
     try:
         bodies = substitution.collect(value)
     except OrchestraError:
         return
     for body in bodies:
-        words = body.split()
+        words = substitution.words(body)
         if len(words) == 2 and words[0] == "arg":
             yield words[1]
 
@@ -319,12 +195,13 @@ class Checker:
     """Runs the static pass over a tree of files, then the interpreter (see module doc)."""
 
     def __init__(self, cli_args: dict[str, str] | None = None):
-        self.tag_attributes, self.tag_children = _tag_rules()
         self.cli_args = dict(cli_args or {})
         self.report = Report()
-        self.sources = _Sources()
         self.graph = networkx.DiGraph()
         self._checked: set[str] = set()
+        # elements (file, line of their start tag) the static pass already found wrong in a
+        # way the interpreter would reject too: its error there is the same problem
+        self._found_elements: set[tuple[str, int | None]] = set()
 
     # ---------------------------------------------------------------- entry points
     def check(self, path: str) -> Report:
@@ -342,11 +219,16 @@ class Checker:
     def _problem(self, severity: str, location: Location, message: str, code: str) -> None:
         self.report.add(Problem(severity, location, message, code))
 
-    def _load(self, path: str) -> Entity | None:
-        from orchestra.launch.convert import load_entity
+    def _report(self, severity: str, entity: Entity, message: str, code: str,
+                attribute: str | None = None) -> None:
+        """A problem with ``entity`` (at ``attribute`` when given), located exactly."""
+        self._problem(severity, entity.where(attribute), message, code)
+        if code in _ALSO_FOUND_BY_INTERPRETER:
+            self._found_elements.add((entity.location.file, entity.location.line))
 
+    def _load(self, path: str) -> Entity | None:
         try:
-            return load_entity(path)
+            return frontends.parse_file(path)
         except OrchestraError as exc:
             self._problem(ERROR, exc.location or Location(path), exc.message, "syntax")
             return None
@@ -374,9 +256,8 @@ class Checker:
         if root is None:
             return False
         if root.tag != "launch":
-            self._problem(ERROR, self.sources.locate(root),
-                          f"the root element must be <launch>, not <{root.tag}>",
-                          "unknown-tag")
+            self._report(ERROR, root, f"the root element must be <launch>, not <{root.tag}>",
+                         rules.UNKNOWN_TAG)
             return True
         scope = _StaticScope(dict(passed_args), path)
         declared: dict[str, Entity] = {}
@@ -384,8 +265,9 @@ class Checker:
         passes_all = False
         includes: list[_Include] = []
         for entity, parent, taken in self._walk(root, None, scope, True):
-            self._check_tag(entity, parent)
-            self._check_required(entity, taken)
+            rule = self._check_tag(entity, parent)
+            if rule is not None:
+                self._check_attributes(entity, rule, scope, taken)
             self._check_substitutions(entity, taken)
             for value in entity.attributes.values():
                 used.update(_arg_references(value))
@@ -395,7 +277,7 @@ class Checker:
                 name = entity.get("name")
                 if name:
                     declared.setdefault(name, entity)
-            if entity.tag == "include" and _is_true(entity.get("pass_all_args") or "") is True:
+            if entity.tag == "include" and _passes_all_args(entity, scope):
                 passes_all = True
             self._check_resources(entity, scope, taken)
             self._check_node_flags(entity, scope)
@@ -428,52 +310,70 @@ class Checker:
             yield from self._walk(child, entity, scope, taken)
 
     # ---------------------------------------------------------------- tags and attributes
-    def _check_tag(self, entity: Entity, parent: Entity | None) -> None:
-        if parent is not None:
-            allowed = self.tag_children.get(parent.tag, ())
-            if entity.tag not in allowed:
-                if entity.tag in self.tag_attributes:
-                    message = f"<{entity.tag}> is not allowed inside <{parent.tag}>"
-                else:
-                    message = f"unknown tag <{entity.tag}>" + _suggest(entity.tag,
-                                                                       self.tag_attributes)
-                self._problem(ERROR, self.sources.locate(entity),
-                              message + " (roslaunch ignores it)", "unknown-tag")
-                return
-        known = self.tag_attributes.get(entity.tag)
-        if known is None:
-            return
-        for name in entity.attributes:
-            if name not in known:
-                self._problem(WARNING, self.sources.locate(entity, name),
-                              f"unknown attribute '{name}' of <{entity.tag}>"
-                              + _suggest(name, known) + " (roslaunch ignores it)",
-                              "unknown-attribute")
-        if entity.has("if") and entity.has("unless"):
-            self._problem(ERROR, self.sources.locate(entity, "unless"),
-                          f"<{entity.tag}> has both 'if' and 'unless'", "if-unless")
+    def _check_tag(self, entity: Entity, parent: Entity | None) -> rules.TagRule | None:
+        """Whether ``entity`` may stand where it is; the rule it is read by, if any."""
+        if parent is None:
+            return rules.rule(entity.tag)
+        parent_rule = rules.TAGS.get(parent.tag)
+        read_as = parent_rule.child_tag(entity.tag) if parent_rule is not None else None
+        if read_as is None:
+            if entity.tag in rules.TAGS:
+                message = f"<{entity.tag}> is not allowed inside <{parent.tag}>"
+            else:
+                message = f"unknown tag <{entity.tag}>" + _suggest(entity.tag, rules.TAGS)
+            self._report(ERROR, entity, message + " (roslaunch ignores it)", rules.UNKNOWN_TAG)
+            return None
+        return rules.TAGS[read_as]
 
-    def _check_required(self, entity: Entity, taken: bool) -> None:
-        missing = [a for a in REQUIRED_ATTRIBUTES.get(entity.tag, ()) if not entity.has(a)]
+    def _check_attributes(self, entity: Entity, rule: rules.TagRule, scope: _StaticScope,
+                          taken: bool) -> None:
+        """The rule table's attribute rules: unknown, both if and unless, missing required,
+        forbidden, and values of the wrong kind (when they resolve without running
+        anything)."""
+        for name in entity.attributes:
+            if name not in rule.allowed:
+                self._report(WARNING, entity, f"unknown attribute '{name}' of <{entity.tag}>"
+                             + _suggest(name, rule.allowed) + " (roslaunch ignores it)",
+                             rules.UNKNOWN_ATTRIBUTE, name)
+        if entity.has("if") and entity.has("unless") and rule.attributes["if"].kind is rules.CONDITION:
+            self._report(ERROR, entity, f"<{entity.tag}> has both 'if' and 'unless'",
+                         rules.IF_UNLESS, "unless")
+        severity, note = self._severity(taken)
+        missing = [a for a in rule.required if not entity.has(a)]
         if missing:
-            severity, note = self._severity(taken)
             names = ", ".join(f"'{a}'" for a in missing)
-            self._problem(severity, self.sources.locate(entity),
-                          f"<{entity.tag}> is missing required attribute(s) {names}{note}",
-                          "missing-attribute")
+            self._report(severity, entity,
+                         f"<{entity.tag}> is missing required attribute(s) {names}{note}",
+                         rules.MISSING_ATTRIBUTE)
+        for name in rule.forbidden:
+            if entity.has(name):
+                self._report(severity, entity, f"<{entity.tag}> cannot have attribute "
+                             f"'{name}'{note}", rules.FORBIDDEN_ATTRIBUTE, name)
+        for name, value in entity.attributes.items():
+            attr = rule.attributes.get(name)
+            if attr is None or attr.kind is rules.STRING:
+                continue
+            resolved = _try_resolve(value, scope)
+            if resolved is None:
+                continue
+            try:
+                rules.parse(rule.tag, name, resolved)
+            except ValueError as exc:
+                self._report(severity, entity, f"<{entity.tag}> attribute '{name}': "
+                             f"{exc}{note}", rules.BAD_VALUE, name)
 
     def _check_substitutions(self, entity: Entity, taken: bool) -> None:
         """``$(...)`` that can never resolve: unknown command, wrong word count, bad eval."""
         values = list(entity.attributes.items())
-        if entity.tag == "rosparam" and entity.text and _is_true(
-                entity.get("subst_value") or "") is True:
+        if entity.tag == "rosparam" and entity.text and rules.truth(
+                "rosparam", "subst_value", entity.get("subst_value") or "") is True:
             values.append(("subst_value", entity.text))
         for name, value in values:
             problem = _substitution_problem(value)
             if problem:
                 severity, note = self._severity(taken)
-                self._problem(severity, self.sources.locate(entity, name),
-                              f"attribute '{name}': {problem}{note}", "bad-substitution")
+                self._report(severity, entity, f"attribute '{name}': {problem}{note}",
+                             "bad-substitution", name)
 
     # ---------------------------------------------------------------- args
     def _check_args(self, path: str, declared: dict[str, Entity], used: set[str],
@@ -483,17 +383,19 @@ class Checker:
         # them, as in roslaunch
         known = set(declared) | passed
         for name in sorted(used - known):
-            entity = self._first_use(path, name)
-            where = self.sources.locate(*entity) if entity else Location(path)
-            self._problem(ERROR, where, f"arg '{name}' is used but never declared in this "
-                          "file" + (" (nor given on the command line)" if top else ""),
-                          "undeclared-arg")
+            use = self._first_use(path, name)
+            message = (f"arg '{name}' is used but never declared in this file"
+                       + (" (nor given on the command line)" if top else ""))
+            if use is None:
+                self._problem(ERROR, Location(path), message, "undeclared-arg")
+            else:
+                self._report(ERROR, use[0], message, "undeclared-arg", use[1] or None)
         if passes_all:
             return  # pass_all_args hands every arg on: none is unused here
         for name, entity in declared.items():
             if name not in used:
-                self._problem(WARNING, self.sources.locate(entity, "name"),
-                              f"arg '{name}' is declared but never used", "unused-arg")
+                self._report(WARNING, entity, f"arg '{name}' is declared but never used",
+                             "unused-arg", "name")
 
     def _first_use(self, path: str, name: str) -> tuple[Entity, str] | None:
         root = self._load_quiet(path)
@@ -512,10 +414,8 @@ class Checker:
         return None
 
     def _load_quiet(self, path: str) -> Entity | None:
-        from orchestra.launch.convert import load_entity
-
         try:
-            return load_entity(path)
+            return frontends.parse_file(path)
         except OrchestraError:
             return None
 
@@ -535,14 +435,14 @@ class Checker:
             return True
         ok = True
         for body in bodies:
-            words = body.split()
+            words = substitution.words(body)
             if len(words) == 2 and words[0] == "find" and "$" not in words[1]:
                 try:
                     find_package(words[1])
                 except PackageNotFound:
                     severity, note = self._severity(taken)
-                    self._problem(severity, self.sources.locate(entity, name),
-                                  f"package '{words[1]}' not found{note}", "missing-package")
+                    self._report(severity, entity, f"package '{words[1]}' not found{note}",
+                                 "missing-package", name)
                     ok = False
         return ok
 
@@ -562,8 +462,8 @@ class Checker:
             path = _try_resolve(raw, scope)
             if path and not os.path.isfile(path):
                 severity, note = self._severity(taken)
-                self._problem(severity, self.sources.locate(entity, name),
-                              f"{name} '{path}' does not exist{note}", "missing-file")
+                self._report(severity, entity, f"{name} '{path}' does not exist{note}",
+                             "missing-file", name)
 
     def _check_executable(self, entity: Entity, scope: _StaticScope, taken: bool) -> None:
         """The node's package exists and holds exactly one executable of that name."""
@@ -577,36 +477,35 @@ class Checker:
         try:
             find_package(pkg)
         except PackageNotFound:
-            self._problem(severity, self.sources.locate(entity, "pkg"),
-                          f"<{entity.tag}> package '{pkg}' not found{note}", "missing-node")
+            self._report(severity, entity, f"<{entity.tag}> package '{pkg}' not found{note}",
+                         "missing-node", "pkg")
             return
         if not exe:
             return
         try:
             find_executable(pkg, exe)
         except OrchestraError as exc:
-            self._problem(severity, self.sources.locate(entity, "type"), exc.message + note,
-                          "missing-node")
+            self._report(severity, entity, exc.message + note, "missing-node", "type")
 
     def _check_node_flags(self, entity: Entity, scope: _StaticScope) -> None:
         if entity.tag != "node":
             return
         respawn = _try_resolve(entity.get("respawn"), scope)
         required = _try_resolve(entity.get("required"), scope)
-        if respawn and required and _is_true(respawn) and _is_true(required):
-            self._problem(ERROR, self.sources.locate(entity, "required"),
-                          "a node cannot be both respawn and required (a required node's "
-                          "exit ends the launch, so it is never respawned)",
-                          "respawn-required")
+        if (respawn and required and rules.truth("node", "respawn", respawn)
+                and rules.truth("node", "required", required)):
+            self._report(ERROR, entity, "a node cannot be both respawn and required (a "
+                         "required node's exit ends the launch, so it is never respawned)",
+                         "respawn-required", "required")
 
     # ---------------------------------------------------------------- includes
     def _resolve_include(self, entity: Entity, scope: _StaticScope, path: str,
                          taken: bool) -> _Include | None:
         raw = entity.get("file")
-        where = self.sources.locate(entity, "file")
+        where = entity.where("file")
         if not raw:
-            self._problem(ERROR, self.sources.locate(entity), "<include> needs a 'file'",
-                          "missing-attribute")
+            if entity.has("file"):
+                self._report(ERROR, entity, "<include> needs a 'file'", rules.MISSING_ATTRIBUTE)
             return None
         target = _try_resolve(raw, scope)
         if target is None:
@@ -614,17 +513,18 @@ class Checker:
         target = os.path.abspath(target)
         if not os.path.isfile(target):
             severity, note = self._severity(taken)
-            self._problem(severity, where, f"included file '{target}' does not exist{note}",
-                          "missing-file")
+            self._report(severity, entity, f"included file '{target}' does not exist{note}",
+                         "missing-file", "file")
             return None
         child_args: dict[str, str] = {}
-        if _is_true(entity.get("pass_all_args") or "") is True:
+        if _passes_all_args(entity, scope):
             child_args.update(scope.args)
         for child in entity.children:
-            if child.tag == "arg" and child.get("name"):
+            name = child.get("name")
+            if child.tag == "arg" and name:
                 value = _try_resolve(child.get("value", child.get("default")), scope)
                 if value is not None:
-                    child_args[child.get("name")] = value
+                    child_args[name] = value
         self.graph.add_edge(path, target, location=where)
         return _Include(path, target, where, child_args)
 
@@ -647,44 +547,25 @@ class Checker:
         one run lists every problem the given args reach. An error the static pass already
         reported on the same line is not repeated (the static one has the column and code).
         """
-        from orchestra.launch.interpreter import LoadOptions
-
         interp = _CollectingInterpreter(LoadOptions(args=dict(self.cli_args), no_exec=True))
         try:
             interp.load_file(path)
-        except OrchestraError as exc:  # the root itself (already reported as syntax)
-            interp.errors.append(exc)
-        static_lines = {(p.location.file, p.location.line) for p in self.report.problems
-                        if p.code in _ALSO_FOUND_BY_INTERPRETER}
-        for exc in interp.errors:
-            where = exc.location or Location(path)
-            if (where.file, where.line) in static_lines:
+        except OrchestraError as failure:  # the root itself (already reported as syntax)
+            interp.errors.append(failure)
+        for error in interp.errors:
+            where = error.location or Location(path)
+            if (where.file, where.line) in self._found_elements:
                 continue
-            self._problem(ERROR, self._precise(where, exc.message), exc.message, "launch")
-        for entity, message in interp.warned:
-            where = self.sources.locate(entity)
-            if "unknown <" in message or "unrecognized" in message:
-                continue  # unknown tags/attributes: the static pass reports them, located
-            self._problem(WARNING, where, message, "launch")
+            if isinstance(error, LaunchError):
+                self._problem(ERROR, error.exact or where, error.message, error.code)
+            else:
+                self._problem(ERROR, where, error.message, rules.INVALID)
+        for finding in interp.findings:
+            if finding.code in (rules.UNKNOWN_TAG, rules.UNKNOWN_ATTRIBUTE):
+                continue  # the static pass reports them in every branch
+            self._problem(WARNING, finding.exact or finding.location, finding.message,
+                          finding.code)
         self._check_plan(interp.plan())
-
-    def _precise(self, where: Location, message: str) -> Location:
-        """Add the column to an interpreter error location when the file text shows it."""
-        if where.line is None or where.column is not None:
-            return where
-        lines = self.sources.lines(where.file)
-        if 0 < where.line <= len(lines):
-            text = lines[where.line - 1]
-            marker = message.find("attribute '")
-            if marker >= 0:
-                attribute = message[marker + 11:].split("'", 1)[0]
-                col = text.find(f"{attribute}=")
-                if col >= 0:
-                    return Location(where.file, where.line, col + 1)
-            col = text.find("<")
-            if col >= 0:
-                return Location(where.file, where.line, col + 1)
-        return where
 
     def _check_plan(self, plan: Any) -> None:
         """What only a resolved plan shows and the interpreter lets through: two ``<test>``s
@@ -700,50 +581,33 @@ class Checker:
                 seen[node.full_name] = node
 
 
-def _collecting_interpreter_class() -> type:
-    from orchestra.launch.interpreter import Interpreter
+class _CollectingInterpreter(Interpreter):
+    """The real interpreter, except that an error skips one element instead of the run.
 
-    class CollectingInterpreter(Interpreter):
-        """The real interpreter, except that an error skips one element instead of the run.
+    Only two methods change: the per-element dispatch (each child is interpreted on its own,
+    and an ``OrchestraError`` is recorded instead of raised) and ``_warn`` (the finding is
+    kept as a value). Every tag rule is the interpreter's own.
+    """
 
-        Only two methods change: the per-element dispatch (each child is interpreted on
-        its own, and an ``OrchestraError`` is recorded instead of raised) and ``_warn`` (the
-        Entity is kept for its location). Every tag rule is the interpreter's own.
-        """
+    def __init__(self, options: LoadOptions):
+        super().__init__(options)
+        self.errors: list[OrchestraError] = []
+        self.findings: list[rules.Finding] = []
 
-        def __init__(self, options: Any):
-            super().__init__(options)
-            self.errors: list[OrchestraError] = []
-            self.warned: list[tuple[Entity, str]] = []
+    def _children(self, children: list[Entity], scope: Scope,
+                  default_machine: Machine | None) -> Machine | None:
+        for entity in children:
+            try:
+                default_machine = super()._children([entity], scope, default_machine)
+            except OrchestraError as exc:
+                self.errors.append(exc)
+        return default_machine
 
-        def _children(self, children: list[Entity], scope: Any, default_machine: Any) -> Any:
-            for entity in children:
-                try:
-                    default_machine = super()._children([entity], scope, default_machine)
-                except OrchestraError as exc:
-                    self.errors.append(exc)
-            return default_machine
-
-        def _warn(self, entity: Entity, message: str) -> None:
-            self.warned.append((entity, message))
-            self.warnings.append(f"{entity.location}: {message}")
-
-    return CollectingInterpreter
-
-
-class _CollectingInterpreterProxy:
-    """Builds the collecting interpreter class on first use (the interpreter is imported
-    lazily so ``orchestra convert`` does not pay for it)."""
-
-    _cls: type | None = None
-
-    def __call__(self, options: Any) -> Any:
-        if self._cls is None:
-            type(self)._cls = _collecting_interpreter_class()
-        return self._cls(options)
-
-
-_CollectingInterpreter = _CollectingInterpreterProxy()
+    def _warn(self, entity: Entity, message: str, code: str = rules.INVALID,
+              attribute: str | None = None) -> None:
+        self.findings.append(rules.Finding(entity.location, message, code, entity.tag,
+                                           attribute, entity.where(attribute)))
+        self.warnings.append(f"{entity.location}: {message}")
 
 
 def _substitution_problem(value: str) -> str | None:
@@ -751,29 +615,29 @@ def _substitution_problem(value: str) -> str | None:
     here: they depend on how the file is launched)."""
     if "$" not in value:
         return None
-    stripped = value.strip()
-    if value.startswith("$(eval ") and value.endswith(")"):
-        return evaluate.problem(stripped[7:-1])
+    expression = substitution.eval_expression(value)
+    if expression is not None:
+        return evaluate.problem(expression)
     try:
         bodies = substitution.collect(value)
     except OrchestraError as exc:
         return exc.message
-    arity = {"find": 1, "env": 1, "anon": 1, "arg": 1, "dirname": 0}
     for body in bodies:
-        words = body.split()
-        if not words or words[0] not in substitution.COMMANDS:
-            command = words[0] if words else ""
-            hint = _suggest(command, substitution.COMMANDS) if command else ""
-            return (f"unknown substitution $({body}){hint}; valid: "
-                    f"{', '.join(substitution.COMMANDS)} (and a whole-value $(eval ...))")
-        if words[0] == "eval":
+        words = substitution.words(body)
+        if words and words[0] == "eval":
             return "$(eval ...) must be the whole value"
-        expected = arity.get(words[0])
-        if expected is not None and len(words) - 1 != expected:
-            return f"$({words[0]}) takes {expected} argument(s): $({body})"
-        if words[0] == "optenv" and len(words) < 2:
-            return f"$(optenv) needs a variable name: $({body})"
+        problem = substitution.body_problem(body)
+        if problem is not None:
+            command = words[0] if words else ""
+            if command not in substitution.COMMANDS and command:
+                problem += _suggest(command, substitution.COMMANDS)
+            return problem
     return None
+
+
+def _passes_all_args(entity: Entity, scope: _StaticScope) -> bool:
+    value = _try_resolve(entity.get("pass_all_args"), scope)
+    return value is not None and rules.truth("include", "pass_all_args", value) is True
 
 
 def _suggest(name: str, known: Any) -> str:

@@ -27,6 +27,8 @@ from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 from orchestra.errors import Location, OrchestraError
 from orchestra.launch import yaml as yaml_frontend
 from orchestra.launch.entity import Entity
+from orchestra.launch.frontends import YAML, format_of, parse_string
+from orchestra.launch.frontends import parse_file as load_entity
 
 FORMATS = ("yaml", "xml")
 _RESOLVER = pyyaml.resolver.Resolver()
@@ -39,20 +41,6 @@ _FLOW_WIDTH = 100
 
 class ConvertError(OrchestraError):
     """A file that cannot be converted (unreadable, or not expressible in the target)."""
-
-
-def format_of(path: str) -> str:
-    """``"yaml"`` or ``"xml"``: which front end reads ``path`` (by its extension)."""
-    return "yaml" if yaml_frontend.is_yaml_launch_file(path) else "xml"
-
-
-def load_entity(path: str) -> Entity:
-    """The root Entity of a launch file, read by the front end its extension calls for."""
-    if format_of(path) == "yaml":
-        return yaml_frontend.parse_file(path)
-    from orchestra.launch import xml as xml_frontend  # the other engineer's front end
-
-    return xml_frontend.parse_file(path)
 
 
 Comments = dict[int, list[str]]
@@ -163,7 +151,7 @@ def _yaml_with_comments(text: str, entity: Entity, comments: Comments) -> str:
     element's line and column, and reads the elements in the same order) and the comment
     lines go in above, indented like the element's ``-``.
     """
-    reread = yaml_frontend.parse_string(text, "<converted>")
+    reread = parse_string(text, "<converted>", YAML)
     lines = text.split("\n")
     inserts: list[tuple[int, list[str]]] = []
     for original, written in zip(_preorder(entity), _preorder(reread), strict=False):
@@ -393,7 +381,7 @@ def is_launch_file(path: str, fmt_from: str) -> bool:
     if fmt_from == "xml":
         if lower.endswith((".launch", ".test")):
             return True
-        if yaml_frontend.is_yaml_launch_file(path):
+        if format_of(path) == YAML:
             return False
         try:
             with open(path, "rb") as fh:
@@ -405,7 +393,7 @@ def is_launch_file(path: str, fmt_from: str) -> bool:
         except (etree.XMLSyntaxError, OSError):
             return False
         return False
-    if not yaml_frontend.is_yaml_launch_file(path):
+    if format_of(path) != YAML:
         return False
     try:
         with open(path, encoding="utf-8") as fh:

@@ -6,9 +6,33 @@ values stay the raw strings written in the file (substitutions unresolved) so th
 """
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from typing import Protocol
 
 from orchestra.errors import Location
+
+
+class SourcePositions(Protocol):
+    """Where a front end read one element: its start tag and its attribute names."""
+
+    def start(self) -> Location: ...
+
+    def attribute(self, name: str) -> Location | None: ...
+
+
+@dataclass(frozen=True)
+class KnownPositions:
+    """Positions a front end had at hand while reading (YAML marks)."""
+
+    start_at: Location
+    attributes: Mapping[str, Location]
+
+    def start(self) -> Location:
+        return self.start_at
+
+    def attribute(self, name: str) -> Location | None:
+        return self.attributes.get(name)
 
 
 @dataclass
@@ -16,7 +40,11 @@ class Entity:
     """A tag with its attributes (name -> raw string, in file order), children and text.
 
     ``text`` is the element's own text (inline YAML of ``<rosparam>``), ``None`` when empty.
-    ``location`` points at the element's start tag; errors about an attribute use it too.
+    ``location`` points at the element's start tag (the line lxml reports for XML, which
+    the plan records); ``positions``, when the front end knows them, give the exact
+    position of the start tag and of each attribute name, so errors and ``orchestra check``
+    point at the column without reading the file again. Positions are not part of equality:
+    the same element read from XML or YAML is equal.
     """
 
     tag: str
@@ -24,6 +52,7 @@ class Entity:
     children: list[Entity] = field(default_factory=list)
     text: str | None = None
     location: Location = field(default_factory=lambda: Location("<unknown>"))
+    positions: SourcePositions | None = field(default=None, compare=False, repr=False)
 
     def get(self, name: str, default: str | None = None) -> str | None:
         """The raw value of attribute ``name``, or ``default`` when it is not written."""
@@ -31,3 +60,21 @@ class Entity:
 
     def has(self, name: str) -> bool:
         return name in self.attributes
+
+    def where(self, attribute: str | None = None) -> Location:
+        """The most exact known position of ``attribute`` (or of the start tag)."""
+        if self.positions is None:
+            return self.location
+        if attribute is not None and attribute in self.attributes:
+            found = self.positions.attribute(attribute)
+            if found is not None:
+                return found
+        return self.positions.start()
+
+    @property
+    def attribute_locations(self) -> dict[str, Location]:
+        """Exact positions of the attributes the front end located."""
+        if self.positions is None:
+            return {}
+        found = {name: self.positions.attribute(name) for name in self.attributes}
+        return {name: where for name, where in found.items() if where is not None}

@@ -21,12 +21,15 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from orchestra.errors import Location, OrchestraError
+from orchestra.launch import rules
 from orchestra.launch.context import Scope, ScopeError
 from orchestra.launch.entity import Entity
 from orchestra.launch.files import read_bytes, read_text
-from orchestra.launch.plan import OUTPUT_MODES, LaunchPlan, Machine, Node, ParamAction, Test
+from orchestra.launch.frontends import parse_file as parse_launch_file
+from orchestra.launch.plan import LaunchPlan, Machine, Node, ParamAction, Test
+from orchestra.launch.rules import LaunchError
 from orchestra.launch.substitution import ArgNotSet, SubstitutionError, resolve
-from orchestra.launch.values import bool_attribute, convert_value, float_attribute, size_attribute
+from orchestra.launch.values import convert_value
 from orchestra.names import canonicalize, is_legal_name, is_private, make_global_ns, ns_join
 
 log = logging.getLogger(__name__)
@@ -35,31 +38,12 @@ ROSLAUNCH_VERSION = "1.16.0"
 DEFAULT_TIMEOUT = 10.0
 TEST_TIME_LIMIT = 60.0
 
-IF_UNLESS = frozenset({"if", "unless"})
-# rosmon's extensions, honoured by the supervisor (docs/compat.md): not unknown attributes
-ROSMON_NODE_ATTRS = frozenset({"stop-timeout", "memory-limit", "cpu-limit", "enable-coredumps"})
-NODE_ATTRS = IF_UNLESS | ROSMON_NODE_ATTRS | {
-    "pkg", "type", "machine", "name", "args", "output", "respawn", "respawn_delay", "cwd", "ns",
-    "clear_params", "launch-prefix", "required"}
-TEST_ATTRS = NODE_ATTRS | {"test-name", "time-limit", "retry"}
-MACHINE_ATTRS = IF_UNLESS | {"name", "address", "env-loader", "ssh-port", "user", "password", "default",
-                 "timeout"}
-PARAM_ATTRS = IF_UNLESS | {"name", "value", "type", "textfile", "binfile", "command"}
-ROSPARAM_ATTRS = IF_UNLESS | {"command", "ns", "file", "param", "subst_value"}
-ARG_ATTRS = IF_UNLESS | {"name", "value", "default", "doc"}
-INCLUDE_ATTRS = IF_UNLESS | {"file", "ns", "clear_params", "pass_all_args"}
-GROUP_ATTRS = IF_UNLESS | {"ns", "clear_params"}
-REMAP_ATTRS = IF_UNLESS | {"from", "to"}
-ENV_ATTRS = IF_UNLESS | {"name", "value"}
-
+__all__ = ["ArgInfo", "Binary", "Interpreter", "LaunchError", "LoadOptions", "binary_to_json",
+           "declared_args", "load_launch", "parse_launch_file"]
 
 # Files deep an include chain may go (real trees are a handful deep; a chain of distinct files
 # has no cycle to stop it).
 MAX_INCLUDE_DEPTH = 100
-
-
-class LaunchError(OrchestraError):
-    """A launch file roslaunch would reject (or that orchestra refuses for safety)."""
 
 
 class Binary(bytes):
@@ -88,26 +72,15 @@ class LoadOptions:
     keep_broken_tests: bool = False
 
 
-def _is_yaml(path: str) -> bool:
-    return path.lower().endswith((".yaml", ".yml"))
-
-
-def parse_launch_file(path: str) -> Entity:
-    """The Entity tree of a launch file, XML or YAML by extension."""
-    if _is_yaml(path):
-        from orchestra.launch import yaml as yaml_front
-        return yaml_front.parse_file(path)
-    from orchestra.launch import xml as xml_front
-    return xml_front.parse_file(path)
-
-
 class Interpreter:
     """Builds one plan; use ``load_file``/``load_entity`` once, then ``plan()``.
 
-    Subclass hooks (``orchestra check`` relies on them; keep their signatures):
-    ``_children(children, scope, default_machine) -> default_machine`` dispatches the
-    elements of a ``<launch>``/``<group>`` body, and ``_warn(entity, message)`` receives
-    every non-fatal problem (unknown tags and attributes, defunct ``<master>``, ...).
+    Tag rules (attributes, required ones, children, value kinds) come from ``rules.TAGS``,
+    the table ``orchestra check`` reads too. Subclass hooks (``orchestra check`` relies on
+    them; keep their signatures): ``_children(children, scope, default_machine) ->
+    default_machine`` dispatches the elements of a ``<launch>``/``<group>`` body, and
+    ``_warn(entity, message, code, attribute)`` receives every non-fatal problem (unknown
+    tags and attributes, defunct ``<master>``, ...).
     """
 
     def __init__(self, options: LoadOptions | None = None):
@@ -152,11 +125,14 @@ class Interpreter:
                           param_actions=tuple(self.param_actions))
 
     # ================================================================ helpers
-    def _error(self, entity: Entity, message: str, attr: str | None = None) -> LaunchError:
+    def _error(self, entity: Entity, message: str, attr: str | None = None,
+               code: str = rules.INVALID) -> LaunchError:
         where = f"<{entity.tag}>" + (f" attribute '{attr}'" if attr else "")
-        return LaunchError(f"{where}: {message}", entity.location)
+        return LaunchError(f"{where}: {message}", entity.location, tag=entity.tag,
+                           attribute=attr, code=code, exact=entity.where(attr))
 
-    def _warn(self, entity: Entity, message: str) -> None:
+    def _warn(self, entity: Entity, message: str, code: str = rules.INVALID,
+              attribute: str | None = None) -> None:
         text = f"{entity.location}: {message}"
         self.warnings.append(text)
         log.warning(text)
@@ -188,39 +164,56 @@ class Interpreter:
 
     def _rosmon_attrs(self, entity: Entity, scope: Scope) -> dict[str, Any]:
         """rosmon's node attributes as Node fields (only those set, so plans stay equal)."""
-        if not entity.attributes.keys() & ROSMON_NODE_ATTRS:
+        if not entity.attributes.keys() & rules.ROSMON_NODE_FIELDS.keys():
             return {}
-        stop, memory, cpu, cores = self._opt(entity, scope, "stop-timeout", "memory-limit",
-                                             "cpu-limit", "enable-coredumps")
         found: dict[str, Any] = {}
-        for attr, text, field_name, parse in (
-                ("stop-timeout", stop, "stop_timeout", float_attribute),
-                ("memory-limit", memory, "memory_limit", size_attribute),
-                ("cpu-limit", cpu, "cpu_limit", float_attribute),
-                ("enable-coredumps", cores, "enable_coredumps", bool_attribute)):
-            if text is None:
-                continue
-            try:
-                value = parse(text, None, attr)
-            except ValueError as exc:
-                raise self._error(entity, str(exc), attr) from None
-            if isinstance(value, float) and value < 0:
-                raise self._error(entity, f"must not be negative: {text}", attr)
-            found[field_name] = value
+        for attr, field_name in rules.ROSMON_NODE_FIELDS.items():
+            (text,) = self._opt(entity, scope, attr)
+            if text is not None:
+                found[field_name] = self._typed(entity, attr, text)
         return found
 
     def _req(self, entity: Entity, scope: Scope, *attrs: str) -> list[str]:
-        for a in attrs:
-            if a not in entity.attributes:
-                raise self._error(entity, f"missing required attribute '{a}'")
+        """The resolved values of attributes the table requires (``_check_attrs`` made sure
+        they are there)."""
         return [self._resolve(entity, a, scope) or "" for a in attrs]
 
-    def _check_attrs(self, entity: Entity, allowed: frozenset[str]) -> None:
-        if entity.attributes.keys() <= allowed:
-            return
-        for attr in entity.attributes:
-            if attr not in allowed:
-                self._warn(entity, f"unknown <{entity.tag}> attribute '{attr}'")
+    def _check_attrs(self, entity: Entity) -> None:
+        """The table's attribute rules for ``entity``: unknown attributes are warned about
+        and ignored, a missing required or a forbidden one is an error."""
+        rule = rules.rule(entity.tag)
+        assert rule is not None  # only known tags are dispatched
+        present = entity.attributes.keys()
+        if not present <= rule.allowed:
+            for attr in entity.attributes:
+                if attr not in rule.allowed:
+                    self._warn(entity, f"unknown <{entity.tag}> attribute '{attr}'",
+                               rules.UNKNOWN_ATTRIBUTE, attr)
+        for attr in rule.required:
+            if attr not in present:
+                raise LaunchError(f"<{entity.tag}>: missing required attribute '{attr}'",
+                                  entity.location, tag=entity.tag, attribute=attr,
+                                  code=rules.MISSING_ATTRIBUTE, exact=entity.where())
+        for attr in rule.forbidden:
+            if attr in present:
+                raise self._error(entity, f"<{entity.tag}> cannot have this attribute", attr,
+                                  rules.FORBIDDEN_ATTRIBUTE)
+        if not rule.children:
+            for child in entity.children:
+                if not (entity.tag == "machine" and child.tag == "env"):  # an error, below
+                    self._warn(child, f"unrecognized <{child.tag}> tag in <{entity.tag}>",
+                               rules.UNKNOWN_TAG)
+
+    def _typed(self, entity: Entity, attr: str, value: str | None, default: Any = None) -> Any:
+        """``value`` (resolved) read as the kind the table gives ``attr``; ``default`` when
+        the attribute is not written."""
+        if value is None:
+            return default
+        try:
+            parsed = rules.parse(entity.tag, attr, value)
+        except ValueError as exc:
+            raise self._error(entity, str(exc), attr, rules.BAD_VALUE) from None
+        return default if parsed is None else parsed
 
     def _enabled(self, entity: Entity, scope: Scope) -> bool:
         """roslaunch's if/unless: both is an error; values must be true/false/1/0."""
@@ -228,13 +221,10 @@ class Interpreter:
         if not has_if and not has_unless:
             return True
         if has_if and has_unless:
-            raise self._error(entity, "cannot set both 'if' and 'unless' on the same tag")
+            raise self._error(entity, "cannot set both 'if' and 'unless' on the same tag",
+                              "unless", rules.IF_UNLESS)
         attr = "if" if has_if else "unless"
-        value = self._resolve(entity, attr, scope) or ""
-        try:
-            flag = convert_value(value, "bool")
-        except ValueError as exc:
-            raise self._error(entity, str(exc), attr) from None
+        flag = self._typed(entity, attr, self._resolve(entity, attr, scope) or "")
         return flag if has_if else not flag
 
     def _set_param(self, name: str, value: Any) -> None:
@@ -244,8 +234,10 @@ class Interpreter:
     # ================================================================ tags
     def _check_launch_tag(self, entity: Entity, scope: Scope) -> None:
         if entity.tag != "launch":
-            raise self._error(entity, "the root element must be <launch>")
+            raise self._error(entity, "the root element must be <launch>",
+                              code=rules.UNKNOWN_TAG)
         if self._enabled(entity, scope):
+            self._check_attrs(entity)
             deprecated = entity.attributes.get("deprecated")
             if deprecated:
                 self._warn(entity, f"DEPRECATED: {deprecated}")
@@ -256,7 +248,7 @@ class Interpreter:
             tag = entity.tag
             handler = _TAGS.get(tag)
             if handler is None:
-                self._warn(entity, f"unrecognized tag <{tag}>")
+                self._warn(entity, f"unrecognized tag <{tag}>", rules.UNKNOWN_TAG)
                 continue
             try:
                 result = handler(self, entity, scope, default_machine)
@@ -283,29 +275,24 @@ class Interpreter:
         except ScopeError as exc:
             raise self._error(entity, str(exc), "ns") from None
         clear = self._resolve(entity, "clear_params", scope)
-        if clear:
-            try:
-                clear_flag = bool_attribute(clear, False, "clear_params")
-            except ValueError as exc:
-                raise self._error(entity, str(exc), "clear_params") from None
-            if clear_flag:
-                if entity.tag in ("node", "test"):
-                    if not node_name:
-                        raise self._error(entity, "'name' must be set to use clear_params",
-                                          "clear_params")
-                    self.clear_params.append(make_global_ns(ns_join(child.ns, node_name)))
-                else:
-                    if not ns:
-                        raise self._error(entity, "'ns' must be set to use clear_params",
-                                          "clear_params")
-                    self.clear_params.append(child.ns)
+        if self._typed(entity, "clear_params", clear, False):
+            if entity.tag in ("node", "test"):
+                if not node_name:
+                    raise self._error(entity, "'name' must be set to use clear_params",
+                                      "clear_params")
+                self.clear_params.append(make_global_ns(ns_join(child.ns, node_name)))
+            else:
+                if not ns:
+                    raise self._error(entity, "'ns' must be set to use clear_params",
+                                      "clear_params")
+                self.clear_params.append(child.ns)
         return child
 
     def _group(self, entity: Entity, scope: Scope, default_machine: Machine | None
                ) -> Machine | None:
         if not self._enabled(entity, scope):
             return None
-        self._check_attrs(entity, GROUP_ATTRS)
+        self._check_attrs(entity)
         child = self._ns_and_clear_params(entity, scope)
         child.params = list(child.params)
         return self._children(entity.children, child, default_machine)
@@ -315,7 +302,7 @@ class Interpreter:
              ) -> None:
         if not self._enabled(entity, scope):
             return None
-        self._check_attrs(entity, ARG_ATTRS)
+        self._check_attrs(entity)
         (name,) = self._req(entity, scope, "name")
         value, default, _doc = self._opt(entity, scope, "value", "default", "doc")
         if value is not None and default is not None:
@@ -331,7 +318,7 @@ class Interpreter:
              ) -> None:
         if not self._enabled(entity, scope):
             return None
-        self._check_attrs(entity, ENV_ATTRS)
+        self._check_attrs(entity)
         name, value = self._req(entity, scope, "name", "value")
         if not name:
             raise self._error(entity, "'name' must be non-empty", "name")
@@ -342,7 +329,7 @@ class Interpreter:
     def _remap_pair(self, entity: Entity, scope: Scope) -> tuple[str, str] | None:
         if not self._enabled(entity, scope):
             return None
-        self._check_attrs(entity, REMAP_ATTRS)
+        self._check_attrs(entity)
         src, dst = self._req(entity, scope, "from", "to")
         return src, dst
 
@@ -370,33 +357,17 @@ class Interpreter:
         if any(legacy):
             raise self._error(entity, "ros-* attributes are not supported since ROS Fuerte; "
                               "use env-loader instead")
-        self._check_attrs(entity, MACHINE_ATTRS)
+        self._check_attrs(entity)
         name, address = self._req(entity, scope, "name", "address")
         env_loader, ssh_port, user, password, default, timeout = self._opt(
             entity, scope, "env-loader", "ssh-port", "user", "password", "default", "timeout")
-        try:
-            port = int(ssh_port or "22")
-        except ValueError:
-            raise self._error(entity, f"not a port number: {ssh_port}", "ssh-port") from None
-        default = (default or "false").lower()
-        if default not in ("true", "false", "never"):
-            raise self._error(entity, f"invalid value: {default} (true, false or never)",
-                              "default")
+        port = self._typed(entity, "ssh-port", ssh_port or "")
+        default = self._typed(entity, "default", default or "")
         for child in entity.children:
             if child.tag == "env":
                 raise self._error(child, "<env> inside <machine> is not supported since ROS "
                                   "Fuerte; use env-loader instead")
-            self._warn(child, f"unrecognized <{child.tag}> tag in <machine>")
-        timeout_value = DEFAULT_TIMEOUT
-        if timeout == "":
-            raise self._error(entity, "cannot be empty", "timeout")
-        if timeout is not None:
-            try:
-                timeout_value = float(timeout)
-            except ValueError:
-                raise self._error(entity, f"must be a number: [{timeout}]", "timeout") from None
-            if timeout_value <= 0:
-                raise self._error(entity, f"must be a positive number: [{timeout}]", "timeout")
+        timeout_value = self._typed(entity, "timeout", timeout, DEFAULT_TIMEOUT)
         if not env_loader:
             distro = os.environ.get("ROS_DISTRO", "")
             env_loader = f"/opt/ros/{distro}/env.sh" if distro else None
@@ -415,18 +386,18 @@ class Interpreter:
                force_local: bool = False) -> None:
         if not self._enabled(entity, scope):
             return None
-        self._check_attrs(entity, PARAM_ATTRS)
-        ptype = (entity.attributes.get("type") or "auto").lower().strip()
+        self._check_attrs(entity)
+        ptype = self._typed(entity, "type", entity.attributes.get("type") or "")
         sources = ("value", "textfile", "binfile", "command")
         vals = self._opt(entity, scope, *sources)
-        given = [s for s, v in zip(sources, vals, strict=False) if v is not None]
+        given = [s for s, v in zip(sources, vals, strict=True) if v is not None]
         if len(given) != 1:
             raise self._error(entity, "<param> must have exactly one of value/textfile/"
                               f"binfile/command (has {', '.join(given) or 'none'})")
-        if "name" not in entity.attributes:
-            raise self._error(entity, "missing required attribute 'name'")
         name = self._resolve(entity, "name", scope, entity.attributes["name"].strip()) or ""
-        value = self._param_value(entity, name, ptype, given[0], vals[sources.index(given[0])])
+        raw = vals[sources.index(given[0])]
+        assert raw is not None  # given[0] is the one source written
+        value = self._param_value(entity, name, ptype, given[0], raw)
         if is_private(name) or force_local:
             scope.add_param(name, value)
         else:
@@ -490,18 +461,12 @@ class Interpreter:
                   ) -> None:
         if not self._enabled(entity, scope):
             return None
-        self._check_attrs(entity, ROSPARAM_ATTRS)
+        self._check_attrs(entity)
         cmd, ns, file_, param, subst = self._opt(entity, scope, "command", "ns", "file",
                                                   "param", "subst_value")
-        try:
-            subst_value = bool_attribute(subst, False, "subst_value")
-        except ValueError as exc:
-            raise self._error(entity, str(exc), "subst_value") from None
+        subst_value = self._typed(entity, "subst_value", subst, False)
         param = ns_join(ns or "", param or "")
-        cmd = cmd or "load"
-        if cmd not in ("load", "dump", "delete"):
-            raise self._error(entity, f"must be 'load', 'dump' or 'delete' (not '{cmd}')",
-                              "command")
+        cmd = self._typed(entity, "command", cmd or "")
         if file_ is not None:
             if cmd == "load" and not os.path.isfile(file_):
                 raise self._error(entity, f"file does not exist [{file_}]", "file")
@@ -581,41 +546,24 @@ class Interpreter:
         return None
 
     def _test_attrs(self, entity: Entity, scope: Scope) -> tuple[str, float, int]:
-        for attr in ("respawn", "respawn_delay", "output"):
-            if attr in entity.attributes:
-                raise self._error(entity, "<test> cannot have this attribute", attr)
         (test_name,) = self._req(entity, scope, "test-name")
         time_limit_raw = self._resolve(entity, "time-limit", scope) or ""
         retry_raw = self._resolve(entity, "retry", scope) or ""
-        time_limit = TEST_TIME_LIMIT
-        if time_limit_raw:
-            try:
-                time_limit = float(time_limit_raw)
-            except ValueError:
-                raise self._error(entity, f"must be a number: [{time_limit_raw}]",
-                                  "time-limit") from None
-            if time_limit <= 0.0:
-                raise self._error(entity, "must be a positive number", "time-limit")
-        retry = 0
-        if retry_raw:
-            try:
-                retry = int(retry_raw)
-            except ValueError:
-                raise self._error(entity, f"must be a number: [{retry_raw}]", "retry") from None
+        time_limit = self._typed(entity, "time-limit", time_limit_raw, TEST_TIME_LIMIT)
+        retry = self._typed(entity, "retry", retry_raw, 0)
         return test_name, time_limit, retry
 
     def _node_or_test(self, entity: Entity, scope: Scope, default_machine: Machine | None,
                       is_test: bool) -> None:
         if not self._enabled(entity, scope):
             return
+        self._check_attrs(entity)
         if is_test:
-            self._check_attrs(entity, TEST_ATTRS)
             (name,) = self._opt(entity, scope, "name")
             test_name, time_limit, retry = self._test_attrs(entity, scope)
             if not name:
                 name = test_name
         else:
-            self._check_attrs(entity, NODE_ATTRS)
             (name,) = self._req(entity, scope, "name")
         if not is_legal_name(name):
             self._warn(entity, f"illegal node name '{name}'")
@@ -633,19 +581,20 @@ class Interpreter:
             raise self._error(entity, "must be non-empty", "machine")
         if not machine and default_machine is not None:
             machine = default_machine.name
-        try:
-            required_flag = bool_attribute(required, False, "required")
-            respawn_flag = bool_attribute(respawn, False, "respawn")
-            delay = float_attribute(respawn_delay, 0.0, "respawn_delay")
-        except ValueError as exc:
-            raise self._error(entity, str(exc)) from None
+        required_flag = self._typed(entity, "required", required, False)
+        respawn_flag = self._typed(entity, "respawn", respawn, False) if not is_test else False
+        delay = self._typed(entity, "respawn_delay", respawn_delay, 0.0) if not is_test else 0.0
         rosmon = self._rosmon_attrs(entity, scope)
 
         remap_scope = scope.child("")
         env_scope = scope.child("")
+        rule = rules.TAGS["test" if is_test else "node"]
         for sub in entity.children:
-            tag = sub.tag.lower()
-            if tag == "remap":
+            tag = rule.child_tag(sub.tag)
+            if tag is None:
+                self._warn(sub, f"unrecognized <{sub.tag}> tag in <{entity.tag}>",
+                           rules.UNKNOWN_TAG)
+            elif tag == "remap":
                 pair = self._remap_pair(sub, scope)
                 if pair is not None:
                     self._add_remap(sub, remap_scope, pair)
@@ -655,8 +604,6 @@ class Interpreter:
                 self._rosparam(sub, param_scope)
             elif tag == "env":
                 self._env(sub, env_scope)
-            else:
-                self._warn(sub, f"unrecognized <{sub.tag}> tag in <{entity.tag}>")
 
         for key, value in [*scope.params, *param_scope.params]:
             if is_private(key):
@@ -671,11 +618,10 @@ class Interpreter:
             raise self._error(entity, "package must be non-empty", "pkg")
         if not node_type.strip():
             raise self._error(entity, "type must be non-empty", "type")
+        cwd = self._typed(entity, "cwd", cwd)
         if cwd == "ros_home":
             cwd = "ROS_HOME"
-        if cwd not in ("ROS_HOME", "node", None):
-            raise self._error(entity, "must be one of 'ROS_HOME', 'node'", "cwd")
-        common = dict(package=pkg, type=node_type, name=name or None,
+        common: dict[str, Any] = dict(package=pkg, type=node_type, name=name or None,
                       namespace=make_global_ns(child.ns), machine_name=machine or None,
                       args=args or "", remap_args=tuple(remap_scope.remap_args()),
                       env_args=tuple(env_scope.env_args), cwd=cwd,
@@ -685,9 +631,7 @@ class Interpreter:
             self.tests.append(Test(output="log", test_name=test_name, time_limit=time_limit,
                                    retry=retry, **common))
             return
-        if output is not None and output not in OUTPUT_MODES:
-            raise self._error(entity, "must be one of "
-                              + ", ".join(f"'{mode}'" for mode in OUTPUT_MODES), "output")
+        output = self._typed(entity, "output", output)
         node = Node(respawn=respawn_flag, respawn_delay=delay, output=output,
                     required=required_flag, **common, **rosmon)
         full = node.full_name
@@ -703,28 +647,24 @@ class Interpreter:
                  ) -> Machine | None:
         if not self._enabled(entity, scope):
             return None
-        self._check_attrs(entity, INCLUDE_ATTRS)
+        self._check_attrs(entity)
         (filename,) = self._req(entity, scope, "file")
-        pass_all = False
-        if "pass_all_args" in entity.attributes:
-            try:
-                pass_all = bool_attribute(self._resolve(entity, "pass_all_args", scope),
-                                          False, "pass_all_args")
-            except ValueError as exc:
-                raise self._error(entity, str(exc), "pass_all_args") from None
+        pass_all = self._typed(entity, "pass_all_args",
+                               self._resolve(entity, "pass_all_args", scope), False)
         child = self._ns_and_clear_params(entity, scope, include_file=filename)
         if pass_all:
             for name, value in scope.args.items():
                 child.add_arg(name, value=value)
             child.pass_all_args = True
+        rule = rules.TAGS["include"]
         for sub in entity.children:
-            tag = sub.tag.lower()
+            tag = rule.child_tag(sub.tag)
             if tag == "env":
                 self._env(sub, child)
             elif tag == "arg":
                 self._arg(sub, child)
             else:
-                self._warn(sub, f"unrecognized <{sub.tag}> tag in <include>")
+                self._warn(sub, f"unrecognized <{sub.tag}> tag in <include>", rules.UNKNOWN_TAG)
         try:
             child.enter_include()
         except ScopeError as exc:
@@ -764,7 +704,8 @@ class Interpreter:
 
 
 def _master(self: Interpreter, entity: Entity, scope: Scope, dm: Machine | None) -> None:
-    self._warn(entity, "ignoring defunct <master> tag")
+    self._check_attrs(entity)
+    self._warn(entity, "ignoring defunct <master> tag", "defunct-tag")
 
 
 _TAGS: dict[str, Callable[..., Any]] = {
@@ -780,6 +721,7 @@ _TAGS: dict[str, Callable[..., Any]] = {
     "env": Interpreter._env,
     "arg": Interpreter._arg,
 }
+assert sorted(_TAGS) == sorted(rules.SCOPE_CHILDREN), "rules.SCOPE_CHILDREN is what dispatches"
 
 
 def declared_args(root: Entity, filename: str, args: dict[str, str] | None = None
@@ -795,20 +737,21 @@ def declared_args(root: Entity, filename: str, args: dict[str, str] | None = Non
     for entity in root.children:
         if entity.tag != "arg" or "name" not in entity.attributes:
             continue
-        values = {}
+        values: dict[str, str | None] = {}
         for attr in ("name", "value", "default", "doc"):
             raw = entity.attributes.get(attr)
             try:
                 values[attr] = resolve(raw, scope)
             except OrchestraError:
                 values[attr] = raw
+        name = values["name"] or ""  # written (checked above), so resolved to a string
         if values["value"] is not None:
-            scope.args.setdefault(values["name"], values["value"])
+            scope.args.setdefault(name, values["value"])
             if values["value"]:
                 continue
         elif values["default"] is not None:
-            scope.args.setdefault(values["name"], values["default"])
-        found.append(ArgInfo(values["name"], values["doc"], values["default"]))
+            scope.args.setdefault(name, values["default"])
+        found.append(ArgInfo(name, values["doc"], values["default"]))
     return found
 
 

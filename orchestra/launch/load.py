@@ -60,7 +60,7 @@ def interpret(files: list[str], args: dict[str, str], *, no_exec: bool, roscore:
                                      keep_broken_tests=keep_broken_tests))
     for path in files:
         if path == "-":
-            from orchestra.launch.xml import parse_string
+            from orchestra.launch.frontends import parse_string
             interp.load_entity(parse_string(sys.stdin.read(), "<stdin>"), "<stdin>")
         else:
             missing = not os.path.isfile(path)
@@ -84,14 +84,14 @@ def find_node(plan: Any, name: str) -> Any:
 
 
 def ros_args_text(paths: list[str], args: dict[str, str]) -> str:
-    from orchestra.launch.interpreter import declared_args, parse_launch_file
+    from orchestra.launch.frontends import parse_file, parse_string
+    from orchestra.launch.interpreter import declared_args
     declared = []
     for path in paths:
         if path == "-":
-            from orchestra.launch.xml import parse_string
             declared += declared_args(parse_string(sys.stdin.read(), "<stdin>"), "<stdin>", args)
         else:
-            declared += declared_args(parse_launch_file(path), path, args)
+            declared += declared_args(parse_file(path), path, args)
     required = [a for a in declared if not a.default]
     optional = [a for a in declared if a.default]
     if not required and not optional:

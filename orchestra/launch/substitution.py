@@ -22,6 +22,12 @@ from orchestra.launch.evaluate import EvalError, evaluate
 from orchestra.names import anonymous_name
 
 COMMANDS = ("find", "env", "optenv", "dirname", "anon", "arg")
+# how many words each command takes after its name: (fewest, most; None = no limit).
+# roslaunch ignores words after $(dirname); $(optenv VAR default words...) joins them.
+ARITY: dict[str, tuple[int, int | None]] = {
+    "find": (1, 1), "env": (1, 1), "optenv": (1, None), "dirname": (0, None), "anon": (1, 1),
+    "arg": (1, 1),
+}
 
 
 class SubstitutionError(OrchestraError):
@@ -38,10 +44,13 @@ class ArgNotSet(SubstitutionError):
 
 
 class Scope(Protocol):
-    """What substitution needs from the loader scope."""
+    """What substitution needs from the loader scope (read only)."""
 
-    args: Mapping[str, str]
-    filename: str | None
+    @property
+    def args(self) -> Mapping[str, str]: ...
+
+    @property
+    def filename(self) -> str | None: ...
 
 
 def _find_package(name: str) -> str:
@@ -93,6 +102,33 @@ def _scan(text: str) -> list[str]:
     return found
 
 
+def words(body: str) -> list[str]:
+    """The words of a ``$(...)`` body: split at spaces, as roslaunch does (not at tabs)."""
+    return [w for w in body.split(" ") if w]
+
+
+def eval_expression(text: str) -> str | None:
+    """The expression of a value that is exactly ``$(eval EXPR)``, else None."""
+    if text.startswith("$(eval ") and text.endswith(")"):
+        return text[7:-1]
+    return None
+
+
+def body_problem(body: str) -> str | None:
+    """Why the ``$(...)`` group ``body`` can never be evaluated (unknown command, wrong
+    number of words), or None."""
+    parts = words(body)
+    if not parts or parts[0] not in COMMANDS:
+        return (f"unknown substitution command [$({body})]; valid commands are "
+                f"{', '.join(COMMANDS)} (and a whole-value $(eval ...))")
+    fewest, most = ARITY[parts[0]]
+    given = len(parts) - 1
+    if given < fewest or (most is not None and given > most):
+        wanted = str(fewest) if fewest == most else f"at least {fewest}"
+        return f"$({parts[0]}) takes {wanted} argument(s) [$({body})]"
+    return None
+
+
 def _env(name: str) -> str:
     try:
         return os.environ[name]
@@ -108,8 +144,6 @@ def _dirname(scope: Scope) -> str:
 
 def _find(resolved: str, body: str, pkg_args: list[str]) -> str:
     """Replace the first ``$(find pkg)`` and the path word after it, like roslaunch."""
-    if len(pkg_args) != 1:
-        raise SubstitutionError(f"$(find pkg) takes exactly one argument [$({body})]")
     token = f"$({body})"
     idx = resolved.find(token)
     before, after = resolved[:idx], resolved[idx + len(token):]
@@ -128,23 +162,15 @@ def _first_pass(resolved: str, body: str, words: list[str], scope: Scope) -> str
     command, args = words[0], words[1:]
     token = f"$({body})"
     if command == "env":
-        if len(args) != 1:
-            raise SubstitutionError(f"$(env var) takes exactly one argument [{token}]")
         return resolved.replace(token, _env(args[0]))
     if command == "optenv":
-        if not args:
-            raise SubstitutionError(f"$(optenv var) needs a variable name [{token}]")
         value = os.environ.get(args[0])
         if value is None:
             value = " ".join(args[1:])
         return resolved.replace(token, value)
     if command == "anon":
-        if len(args) != 1:
-            raise SubstitutionError(f"$(anon name) takes exactly one name [{token}]")
         return resolved.replace(token, anonymous_name(args[0]))
     if command == "arg":
-        if len(args) != 1:
-            raise SubstitutionError(f"$(arg name) takes exactly one name [{token}]")
         if args[0] not in scope.args:
             raise ArgNotSet(args[0])
         return resolved.replace(token, scope.args[args[0]])
@@ -157,26 +183,29 @@ def resolve(text: str | None, scope: Scope) -> str | None:
     """``text`` with every substitution arg evaluated; ``None`` stays ``None``."""
     if not text or "$" not in text:
         return text
-    if text.startswith("$(eval ") and text.endswith(")"):
-        return _eval(text[7:-1], scope)
-    bodies = collect(text)
+    expression = eval_expression(text)
+    if expression is not None:
+        return _eval(expression, scope)
     parsed = []
-    for body in bodies:
-        words = [w for w in body.split(" ") if w]
-        if not words or words[0] not in COMMANDS:
-            raise SubstitutionError(f"unknown substitution command [$({body})]; valid commands "
-                                    f"are {', '.join(COMMANDS)} (and a whole-value $(eval ...))")
-        parsed.append((body, words))
+    for body in collect(text):
+        problem = body_problem(body)
+        if problem is not None:
+            raise SubstitutionError(problem)
+        parsed.append((body, words(body)))
     resolved = text
-    for body, words in parsed:
-        resolved = _first_pass(resolved, body, words, scope)
+    for body, parts in parsed:
+        resolved = _first_pass(resolved, body, parts, scope)
     if "$" in resolved:
+        # $(find) last; what the first pass left (from arg values) is only checked for
+        # unknown commands, as roslaunch does
         for body in collect(resolved):
-            words = [w for w in body.split(" ") if w]
-            if not words or words[0] not in COMMANDS:
-                raise SubstitutionError(f"unknown substitution command [$({body})]")
-            if words[0] == "find":
-                resolved = _find(resolved, body, words[1:])
+            parts = words(body)
+            problem = body_problem(body)
+            if problem is not None and (not parts or parts[0] not in COMMANDS
+                                        or parts[0] == "find"):
+                raise SubstitutionError(problem)
+            if parts[0] == "find":
+                resolved = _find(resolved, body, parts[1:])
     return resolved
 
 

@@ -28,13 +28,11 @@ refused outright.
 """
 from __future__ import annotations
 
-import os
-
 import yaml as pyyaml
 from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 
 from orchestra.errors import Location, OrchestraError, offset_location
-from orchestra.launch.entity import Entity
+from orchestra.launch.entity import Entity, KnownPositions
 from orchestra.params.yaml import char_name as _char_name
 from orchestra.params.yaml import reader_error_location
 
@@ -72,11 +70,6 @@ _CORE_TAGS = frozenset(_CORE_TAG_PREFIX + name for name in (
 # libyaml's composer when PyYAML was built with it (much faster than the pure-Python one, and
 # ``orchestra launch`` start-up time matters); same nodes, tags and marks as the pure one.
 _LOADER = getattr(pyyaml, "CSafeLoader", pyyaml.SafeLoader)
-
-ENTITY_ATTRIBUTE_LOCATIONS = "attribute_locations"
-"""Name of the per-entity dict {attribute: Location} this front end attaches (instance
-attribute, not a dataclass field, so Entity equality stays the same for both front ends)."""
-
 
 class LaunchYamlError(OrchestraError):
     """A YAML launch file that is not valid YAML or not the launch schema."""
@@ -217,7 +210,7 @@ def _element(tag: str, key: Node, body: Node, filename: str, guard: _Guard) -> E
 def _element_body(tag: str, key: Node, body: Node, filename: str, guard: _Guard) -> Entity:
     entity = Entity(tag=tag, location=_location(filename, key))
     attribute_locations: dict[str, Location] = {}
-    setattr(entity, ENTITY_ATTRIBUTE_LOCATIONS, attribute_locations)
+    entity.positions = KnownPositions(entity.location, attribute_locations)
     if isinstance(body, ScalarNode):
         if body.tag == _CORE_TAG_PREFIX + "null" and body.value in ("", "~", "null", "Null",
                                                                     "NULL"):
@@ -229,6 +222,7 @@ def _element_body(tag: str, key: Node, body: Node, filename: str, guard: _Guard)
     if isinstance(body, SequenceNode):
         entity.children.extend(_children(body, filename, guard, list_of=tag))
         return entity
+    assert isinstance(body, MappingNode)  # scalar and sequence bodies returned above
     aliases = ATTRIBUTE_ALIASES.get(tag, {})
     for item_key, value in _mapping_items(body, filename):
         name = _key_text(item_key, filename)
@@ -341,8 +335,3 @@ def _child(item: Node, filename: str, guard: _Guard, list_of: str | None) -> lis
             "(a mapping with exactly one key)" + hint, _location(filename, item))
     key, body = item.value[0]
     return [_element(_key_text(key, filename), key, body, filename, guard)]
-
-
-def is_yaml_launch_file(path: str) -> bool:
-    """Whether ``path`` is read by this front end (``.yaml``/``.yml``, e.g. ``x.launch.yaml``)."""
-    return os.path.splitext(path)[1].lower() in (".yaml", ".yml")
