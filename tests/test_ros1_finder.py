@@ -268,3 +268,12 @@ def test_unknown_package_of_any_name_is_explained_only_for_msg_imports(layer):
         import l10_nowhere  # noqa: F401
     assert "no ROS package" not in str(plain.value)
     assert importlib.util.find_spec("l10_nowhere") is None
+
+
+def test_dir_of_a_message_module_lists_its_types_before_any_is_built(layer):
+    _package(layer, "l10_dir", {"msg/A.msg": "int8 a\n", "srv/S.srv": "---\n"})
+    import l10_dir.msg
+    import l10_dir.srv
+
+    assert "A" in dir(l10_dir.msg)
+    assert {"S", "SRequest", "SResponse"} <= set(dir(l10_dir.srv))

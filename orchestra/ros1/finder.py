@@ -143,6 +143,10 @@ class _MessageModuleLoader(importlib.abc.Loader):
                     service = plain(part[0])
                     return getattr(service, f"_{part[1].lower()}_class")
         setattr(module, "__getattr__", getattr_)  # noqa: B010 - PEP 562 module hook
+
+        def dir_() -> list[str]:   # dir(pkg.msg) lists the types, as a generated module does
+            return sorted(set(module.__dict__) | set(getattr_("__all__")))
+        setattr(module, "__dir__", dir_)  # noqa: B010 - PEP 562 module hook
         module.__doc__ = f"{kind} classes of package {pkg} (orchestra's ROS 1 layer)"
 
 
