@@ -277,3 +277,11 @@ def test_dir_of_a_message_module_lists_its_types_before_any_is_built(layer):
 
     assert "A" in dir(l10_dir.msg)
     assert {"S", "SRequest", "SResponse"} <= set(dir(l10_dir.srv))
+
+
+def test_unknown_mode_warns_once_and_means_auto():
+    out = _run(sys.executable, "from std_msgs.msg import String; print(String._type)",
+               ORCHESTRA_ROS1="yes")
+    assert out.returncode == 0 and out.stdout.strip() == "std_msgs/String"
+    assert out.stderr.strip() == ("orchestra: warning: ORCHESTRA_ROS1='yes' is not one of "
+                                  "auto, layer, real; using auto")

@@ -39,9 +39,24 @@ def real_rospy_available(path: Sequence[str], site_dir: str = SITE_DIR) -> bool:
     return PathFinder.find_spec("rospy", without_site(path, site_dir)) is not None
 
 
+def mode_of(environ: Mapping[str, str]) -> str:
+    """The requested mode; an unknown value counts as ``auto`` (see ``bad_mode``)."""
+    mode = environ.get(ENV_VAR, "auto").strip().lower() or "auto"
+    return mode if mode in MODES else "auto"
+
+
+def bad_mode(environ: Mapping[str, str]) -> str | None:
+    """A one-line warning when ``ORCHESTRA_ROS1`` holds something other than a mode."""
+    value = environ.get(ENV_VAR, "").strip().lower()
+    if value and value not in MODES:
+        return (f"orchestra: warning: {ENV_VAR}={environ[ENV_VAR]!r} is not one of "
+                f"{', '.join(MODES)}; using auto")
+    return None
+
+
 def decide(environ: Mapping[str, str], path: Sequence[str], site_dir: str = SITE_DIR) -> bool:
     """True when this process should use the layer (see the module docstring)."""
-    mode = environ.get(ENV_VAR, "auto").strip().lower() or "auto"
+    mode = mode_of(environ)
     if mode == "layer":
         return True
     if mode == "real":

@@ -26,6 +26,9 @@ def _activate():
     # nothing and "real" leaves no trace of orchestra in the process
     activation = _load_file("_orchestra_ros1_activation",
                             os.path.join(os.path.dirname(here), "activation.py"))
+    warning = activation.bad_mode(os.environ)
+    if warning:
+        sys.stderr.write(warning + "\n")
     if not activation.decide(os.environ, sys.path, here):
         sys.path[:] = activation.without_site(sys.path, here)
         return
