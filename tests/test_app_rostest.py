@@ -221,3 +221,10 @@ def test_a_required_node_dying_during_a_test_fails_it(tmp_path):
     assert verdicts(junit) == {"outlived": "failure"}
     assert "required process /critical died" in proc.stdout
     assert left_running(tmp_path) == []
+
+
+def test_retry_runs_a_failed_test_again_on_a_fresh_run(tmp_path):
+    proc, junit = orchestra_test(tmp_path, str(TESTS / "retry.test"))
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert verdicts(junit) == {"flaky": "passed"}
+    assert "failed, retrying. Retries left: 1" in proc.stderr

@@ -1,16 +1,21 @@
 #!/usr/bin/env python3
-"""A rostest test program without ROS: ``verdict.py pass|fail|hang``.
+"""A rostest test program without ROS: ``verdict.py pass|fail|hang|flaky``.
 
-One unittest case that passes, fails, or never ends; its JUnit results go where
+One unittest case that passes, fails, never ends, or (flaky) fails on its first run in this
+working directory and passes afterwards; its JUnit results go where
 ``--gtest_output=xml:PATH`` says, as rosunit writes them. Standard library only, so Debian's
 rostest and ``orchestra test`` run the very same program.
 """
+import os
 import sys
 import time
 import unittest
 from xml.sax.saxutils import quoteattr
 
-MODE = next((a for a in sys.argv[1:] if a in ("pass", "fail", "hang")), "pass")
+MODE = next((a for a in sys.argv[1:] if a in ("pass", "fail", "hang", "flaky")), "pass")
+if MODE == "flaky":
+    MODE = "pass" if os.path.exists("flaky.ran") else "fail"
+    open("flaky.ran", "w").close()
 FLAG = "--gtest_output=xml:"
 
 
