@@ -147,3 +147,11 @@ def test_broken_definition_is_reported_at_its_file_and_line(tmp_path):
 def test_bare_name_not_found_says_so_like_rosmsg():
     out = _orchestra("msg", "show", "NoSuchTypeAnywhere")
     assert out.returncode == 1 and out.stderr == "Could not find msg 'NoSuchTypeAnywhere'\n"
+
+
+def test_type_can_be_piped_in_as_from_topic_type():
+    result = CliRunner().invoke(msg, ["show"], input="\ngeometry_msgs/Vector3\n")
+    assert result.exit_code == 0, result.output
+    assert result.output == "float64 x\nfloat64 y\nfloat64 z\n\n"
+    result = CliRunner().invoke(srv, ["md5"], input="std_srvs/Trigger\n")
+    assert result.output == "937c9679a518e3a18d831e57125ea522\n"

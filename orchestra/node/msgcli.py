@@ -44,7 +44,19 @@ def _spec(type_name: str) -> MsgSpec:
     return spec
 
 
-def _check_name(type_name: str, kind: str) -> str:
+def _from_stdin(value: str | None) -> str:
+    """rosmsg's pipe form (``orchestra topic type /x | orchestra msg show``): the argument, or
+    the first non-empty line of stdin."""
+    if value:
+        return value
+    for line in click.get_text_stream("stdin"):
+        if line.strip():
+            return line.strip()
+    raise click.UsageError("give a type (or pipe one in, as from `orchestra topic type`)")
+
+
+def _check_name(type_name: str | None, kind: str) -> str:
+    type_name = _from_stdin(type_name)
     if type_name.endswith("." + kind):
         type_name = type_name[: -len(kind) - 1]
     if "::" in type_name or "." in type_name:
@@ -113,8 +125,8 @@ def _group(kind: str) -> click.Group:
     @group.command("show", help=f"Show the fields of {noun} TYPE (pkg/Name, or Name to "
                                 "search every package).")
     @click.option("-r", "--raw", is_flag=True, help="The definition as written, with comments.")
-    @click.argument("type_name", metavar="TYPE")
-    def show(raw: bool, type_name: str) -> None:
+    @click.argument("type_name", metavar="TYPE", required=False)
+    def show(raw: bool, type_name: str | None) -> None:
         type_name = _check_name(type_name, kind)
         if "/" in type_name:
             click.echo(show_text(type_name, kind, raw))
@@ -128,8 +140,8 @@ def _group(kind: str) -> click.Group:
             click.echo(show_text(full, kind, raw))
 
     @group.command("md5", help=f"The md5 sum of {noun} TYPE.")
-    @click.argument("type_name", metavar="TYPE")
-    def md5(type_name: str) -> None:
+    @click.argument("type_name", metavar="TYPE", required=False)
+    def md5(type_name: str | None) -> None:
         type_name = _check_name(type_name, kind)
         if "/" in type_name:
             click.echo(md5_of(type_name, kind))
@@ -149,9 +161,10 @@ def _group(kind: str) -> click.Group:
 
     @group.command("package", help=f"The {noun} types of PACKAGE.")
     @click.option("-s", "single_line", is_flag=True, help="On one line.")
-    @click.argument("package")
-    def package(single_line: bool, package: str) -> None:
-        click.echo((" " if single_line else "\n").join(package_listing(package, kind)))
+    @click.argument("package", required=False)
+    def package(single_line: bool, package: str | None) -> None:
+        listing = package_listing(_from_stdin(package), kind)
+        click.echo((" " if single_line else "\n").join(listing))
 
     @group.command("packages", help=f"The packages that have {noun} types.")
     @click.option("-s", "single_line", is_flag=True, help="On one line.")
