@@ -184,10 +184,14 @@ class Player:
 
     def _play_once(self, first: int, end: int | None) -> None:
         opts = self.opts
-        wall_start = time.monotonic()
+        wall_start = -1.0
         for conn, stamp, data in merged(self.readers, opts.topics, first, end):
             if self.stopped.is_set():
                 return
+            if wall_start < 0:
+                # the timeline starts when the first message is at hand (not before reading
+                # its chunk), so the first one is not late relative to all the others
+                wall_start = time.monotonic() - (stamp - first) / NS / opts.rate
             if not opts.immediate:
                 wall_start = self._wait_until(wall_start, first, stamp)
                 if wall_start < 0:
