@@ -408,3 +408,31 @@ def test_play_clock_publishes_the_bag_time(master, tmp_path):
     assert echo.returncode == 0, echo.stderr
     secs = int(echo.stdout.split("secs:")[1].split()[0])
     assert T0 // 10**9 <= secs <= T0 // 10**9 + 3, echo.stdout
+
+
+def test_kill_9_of_the_recorder_leaves_a_bag_that_reindex_repairs(master, tmp_path):
+    env = _env(master)
+    out = tmp_path / "killed.bag"
+    active = tmp_path / "killed.bag.active"
+    rec = _start([sys.executable, "-m", "orchestra", "bag", "record", "-q", "-O", str(out),
+                  "--chunksize", "2", "/numbers"], env)
+    pub = None
+    try:
+        wait_for(lambda: _subscribed(master.uri, "/numbers"), timeout=20)
+        pub = _start([sys.executable, str(FIXTURES / "burst.py"), "/numbers", "100000",
+                      "2000"], env)
+        wait_for(lambda: active.exists() and active.stat().st_size > 40_000, timeout=30)
+        rec.proc.kill()  # SIGKILL: no chance to write the index
+        rec.wait(timeout=10)
+    finally:
+        rec.kill()
+        if pub is not None:
+            pub.kill()
+    info = _orchestra("bag", "info", str(active))
+    assert info.returncode == 2 and "bag reindex" in info.stderr, info.stderr
+    fixed = _orchestra("bag", "reindex", str(active))
+    assert fixed.returncode == 0, fixed.stderr
+    with BagReader(str(active)) as r:
+        got = [d for _, _, d in r.messages()]
+    assert len(got) > 500
+    assert got == [_string(f"n {i}") for i in range(len(got))]
