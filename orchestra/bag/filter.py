@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import ast
 
-from orchestra.bag.expression import Expression, compile_expression
+from orchestra.bag.expression import Expression, ExpressionError, compile_expression
 from orchestra.bag.records import Connection
 from orchestra.bag.rewrite import rewrite
 from orchestra.node.decode import RawDecoder
@@ -31,7 +31,11 @@ def filter_bag(src: str, dst: str, expr: Expression, compression: str = "none") 
                                                  stamp % 1_000_000_000)}
         if needs_message:
             values["m"] = decoder.decode(conn.header, data)
-        return bool(expr.evaluate(values))
+        try:
+            return bool(expr.evaluate(values))
+        except ExpressionError as exc:
+            raise ExpressionError(f"on the {conn.topic} message at {values['t'].to_sec():.6f}:"
+                                  f" {exc}") from None
 
     return rewrite(src, dst, compression, keep)
 
