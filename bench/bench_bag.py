@@ -209,7 +209,11 @@ def bench_play(env: dict, tool: str, bag: str, n: int, hz: int) -> dict:
                                   stderr=subprocess.DEVNULL)
         arrivals = read(sub, "arrivals", timeout=60)["arrivals"]
     finally:
-        stop(sub)
+        sub.send_signal(signal.SIGINT)  # unregisters: no stale subscriber for the next round
+        try:
+            sub.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            stop(sub)
         if player is not None:
             player.wait(timeout=30)
     errors = sorted(abs((a - arrivals[0]) - i / hz) for i, a in enumerate(arrivals))
@@ -252,13 +256,15 @@ def main() -> None:
                 for kind in ("twist", "image"):
                     for tool in tools:
                         row = bench_record(env, tool, kind, counts[kind], tmp)
+                        print(f"# record {kind} {tool}: {row}", flush=True)
                         results.setdefault((f"record {kind}", tool), []).append(row)
             bag = os.path.join(tmp, "timed.bag")
             n = make_timed_bag(bag)
             for _ in range(rounds):
                 for tool in tools:
-                    results.setdefault(("play", tool), []).append(
-                        bench_play(env, tool, bag, n, 100))
+                    row = bench_play(env, tool, bag, n, 100)
+                    print(f"# play {tool}: {row}", flush=True)
+                    results.setdefault(("play", tool), []).append(row)
     finally:
         master.shutdown()
     print("\n| record | " + " | ".join(tools) + " | ratio (orchestra/rosbag) |")

@@ -21,6 +21,8 @@ from orchestra.bag.records import BagFormatError, Connection
 log = logging.getLogger(__name__)
 
 NS = 1_000_000_000
+#: --wait-for-subscribers: how long to wait for more subscribers once each topic has one
+LATE_SUBSCRIBERS = 3.0
 
 
 @dataclass
@@ -134,15 +136,23 @@ class Player:
             self.stopped.wait(self.opts.delay)
 
     def _wait_for_subscribers(self) -> None:
-        """Wait until every topic is connected to at least one subscriber and to every
-        subscriber the master listed when we started (rosbag waits for one only: a second
-        subscriber would miss the first messages)."""
+        """Wait until every topic has a subscriber (rosbag's rule), then up to
+        ``LATE_SUBSCRIBERS`` seconds more for the other subscribers the master listed when
+        play started, so a second subscriber does not miss the first messages (a listed
+        subscriber that died without unregistering cannot make play wait forever)."""
         from orchestra.node.runtime import get_runtime
         _pubs, subs, _srvs = get_runtime().master.call("getSystemState")
         listed = {topic: len(nodes) for topic, nodes in subs}
+        for pub, _md5 in self._pubs.values():
+            while pub.get_num_connections() < 1:  # type: ignore[attr-defined]
+                if self.stopped.wait(0.01):
+                    return
+        deadline = time.monotonic() + LATE_SUBSCRIBERS
         for topic, (pub, _md5) in self._pubs.items():
-            need = max(1, listed.get(topic, 0))
-            while pub.get_num_connections() < need:  # type: ignore[attr-defined]
+            while pub.get_num_connections() < listed.get(topic, 0):  # type: ignore[attr-defined]
+                if time.monotonic() > deadline:
+                    log.warning("%s: not every listed subscriber connected", topic)
+                    break
                 if self.stopped.wait(0.01):
                     return
 
