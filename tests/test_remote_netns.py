@@ -260,3 +260,20 @@ def test_unreachable_machine_fails_fast_with_nothing_started(bed, run):
     assert len(text.splitlines()) == 1 and f"machine 'far' ({silent}:22)" in text, text
     assert run.records("here") == []
     assert leftovers(bed) == []
+
+
+def test_check_machines_warns_about_a_machine_it_cannot_reach(bed, run):
+    def check(**values) -> subprocess.CompletedProcess:
+        return bed.in_local([sys.executable, "-m", "orchestra", "check", "--check-machines",
+                             str(run.launch_file(**values))], env=run.env,
+                            capture_output=True, text=True, timeout=60)
+
+    good = check()
+    assert good.returncode == 0 and "[machine]" not in good.stdout, good.stdout + good.stderr
+    bad = check(port=2222)
+    assert bad.returncode == 0, bad.stdout + bad.stderr               # a warning, not an error
+    warnings = [line for line in bad.stdout.splitlines() if "[machine]" in line]
+    assert len(warnings) == 1, bad.stdout
+    assert "warning: machine 'far'" in warnings[0] and "Connection refused" in warnings[0]
+    assert "two.launch:" in warnings[0]
+    assert leftovers(bed) == []

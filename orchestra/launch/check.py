@@ -78,6 +78,7 @@ class Report:
 
     problems: list[Problem] = field(default_factory=list)
     files: list[str] = field(default_factory=list)
+    plans: list[Any] = field(default_factory=list)    # resolved plans (``--check-machines``)
 
     @property
     def errors(self) -> list[Problem]:
@@ -570,6 +571,7 @@ class Checker:
     def _check_plan(self, plan: Any) -> None:
         """What only a resolved plan shows and the interpreter lets through: two ``<test>``s
         (or a test and a node) with the same full name (it rejects duplicate nodes itself)."""
+        self.report.plans.append(plan)
         seen: dict[str, Any] = {}
         for node in (*plan.nodes, *plan.tests):
             if node.full_name in seen:

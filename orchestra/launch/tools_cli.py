@@ -61,13 +61,32 @@ def _expand(paths: list[str]) -> list[str]:
     return files
 
 
+def _add_machine_warnings(report) -> None:
+    """``--check-machines``: the launch's own preflight per remote machine, as warnings.
+
+    (The one place where ``check`` reaches beyond launch files, hence the import of
+    orchestra.remote here, only when asked.)
+    """
+    from orchestra.errors import Location
+    from orchestra.launch.check import WARNING, Problem
+    from orchestra.remote.reach import check_machines
+
+    for problem in check_machines(report.plans):
+        where = problem.location or Location(report.files[0] if report.files else "<launch>")
+        report.add(Problem(WARNING, where, problem.message, "machine"))
+
+
 @click.command()
 @click.argument("words", nargs=-1, required=True, metavar="FILE|DIR... [name:=value ...]")
 @click.option("--strict", is_flag=True, help="Warnings fail the check too.")
 @click.option("--json", "as_json", is_flag=True,
               help="Print the problems as one JSON document (for editors and CI).")
+@click.option("--check-machines", is_flag=True,
+              help="Also connect to every remote <machine> (ssh, env-loader, orchestra and "
+                   "the nodes' executables there) and warn about those that fail.")
 @click.pass_context
-def check(ctx: click.Context, words: tuple[str, ...], strict: bool, as_json: bool) -> None:
+def check(ctx: click.Context, words: tuple[str, ...], strict: bool, as_json: bool,
+          check_machines: bool) -> None:
     """Report every problem in launch files (and what they include), starting nothing.
 
     A DIR stands for every launch file under it. Args apply to every file checked.
@@ -87,6 +106,8 @@ def check(ctx: click.Context, words: tuple[str, ...], strict: bool, as_json: boo
         report = check_tree(_expand(paths), args)
     else:
         report = check_files(paths, args)
+    if check_machines:
+        _add_machine_warnings(report)
     if as_json:
         import json
 
