@@ -19,6 +19,7 @@ COMMANDS: dict[str, str] = {
     "launch": "orchestra.app.cli:launch",
     "check": "orchestra.launch.tools_cli:check",
     "convert": "orchestra.launch.tools_cli:convert",
+    "export": "orchestra.export.cli:export",
     "pkg": "orchestra.packages.cli:pkg",
     "run": "orchestra.packages.cli:run",
     "create-pkg": "orchestra.packages.cli:create_pkg",

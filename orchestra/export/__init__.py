@@ -1,0 +1,1 @@
+"""Launch plans written out for other process managers (``orchestra export``)."""
