@@ -134,6 +134,13 @@ def leftovers(bed) -> list[int]:
             if pid != bed.sshd.pid]
 
 
+def cmdline(pid: int) -> bytes:
+    try:
+        return Path(f"/proc/{pid}/cmdline").read_bytes()
+    except OSError:
+        return b""
+
+
 def netns_of(pid: int) -> int:
     return os.stat(f"/proc/{pid}/ns/net").st_ino
 
@@ -276,4 +283,19 @@ def test_check_machines_warns_about_a_machine_it_cannot_reach(bed, run):
     assert len(warnings) == 1, bad.stdout
     assert "warning: machine 'far'" in warnings[0] and "Connection refused" in warnings[0]
     assert "two.launch:" in warnings[0]
+    assert leftovers(bed) == []
+
+
+def test_lost_connection_stops_the_remote_nodes_and_the_launch_sees_them_die(bed, run):
+    proc = run.start()
+    found = wait_started(run)
+    masters = [pid for pid in bed.pids_in(bed.local_ns) if b"\0-M\0" in cmdline(pid)]
+    assert len(masters) == 1                            # one connection for three nodes
+    os.kill(masters[0], signal.SIGKILL)                 # the network connection is gone
+    output, _ = proc.communicate(timeout=40)
+    text = output.decode(errors="replace")
+    assert proc.returncode == 1, text                   # the required remote node "died"
+    assert "required process /arm/boss died (exit code 255)" in text
+    remote = [found[n][-1]["pid"] for n in ("talker", "boss")]
+    assert not any(os.path.exists(f"/proc/{pid}") for pid in remote)
     assert leftovers(bed) == []
