@@ -195,6 +195,9 @@ def test_remote_argv_env_are_roslaunchs_and_sigint_stops_both_sides(bed, run):
     assert talker["cwd"] == str(bed.root / "remote_home")      # ROS_HOME there
     remote_logs = list((bed.root / "remote_log").glob("*/talker-*-stdout.log"))
     assert any(b"hello from talker" in p.read_bytes() for p in remote_logs)
+    if not compare_with_real_roslaunch(bed, run, found):
+        pytest.skip("the rules above hold; Debian's roslaunch (python3-roslaunch) is not "
+                    "installed to compare with it directly")
 
 
 def test_sigkilled_orchestra_leaves_no_remote_process(bed, run):
@@ -299,3 +302,49 @@ def test_lost_connection_stops_the_remote_nodes_and_the_launch_sees_them_die(bed
     remote = [found[n][-1]["pid"] for n in ("talker", "boss")]
     assert not any(os.path.exists(f"/proc/{pid}") for pid in remote)
     assert leftovers(bed) == []
+
+
+ROSLAUNCH_SIDE = r'''
+import json, sys
+from roslaunch.core import Machine, Node, setup_env
+from roslaunch.node_args import create_local_process_args
+spec = json.loads(sys.argv[1])
+node = Node("rdemo", "probe", name=spec["name"], namespace=spec["namespace"],
+            args=spec["args"], remap_args=spec["remaps"], env_args=spec["env"])
+machine = Machine("far", spec["address"], env_loader=spec["loader"])
+node.machine = machine
+env = setup_env(node, machine, spec["master_uri"])
+print(json.dumps({"argv": create_local_process_args(node, machine),
+                  "env": {k: env.get(k) for k in ("ROS_MASTER_URI", "ROS_NAMESPACE",
+                                                  "NODE_ENV")}}))
+'''
+
+
+def compare_with_real_roslaunch(bed, run, found) -> bool:
+    """roslaunch's remote child builds a node's process with create_local_process_args and
+    setup_env, on the remote machine, after the env-loader: run exactly that there and
+    compare. False when Debian's roslaunch is not installed."""
+    probe = subprocess.run(["/usr/bin/python3", "-c", "import roslaunch.node_args"],
+                           capture_output=True)
+    if probe.returncode != 0:
+        return False
+    for name, namespace, args, remaps, env in (
+            ("talker", "/", "a 'b c'", [["chatter", "/news"]], [["NODE_ENV", "v1"]]),
+            ("boss", "/arm/", "", [], [["PROBE_OUT", str(run.out)],
+                                       ["PROBE_MODE", "die_on_file"]])):
+        record = found[name][0]
+        spec = {"name": name, "namespace": namespace, "args": args, "remaps": remaps,
+                "env": env, "address": bed.remote_ip, "loader": str(bed.loader),
+                "master_uri": record["env"]["ROS_MASTER_URI"]}
+        ros = subprocess.run(["ip", "netns", "exec", bed.remote_ns, str(bed.loader),
+                              "/usr/bin/python3", "-c", ROSLAUNCH_SIDE, json.dumps(spec)],
+                             capture_output=True, text=True, timeout=60,
+                             env={"PATH": "/usr/bin:/bin"})
+        assert ros.returncode == 0, ros.stderr
+        expected = json.loads(ros.stdout)
+        # roslaunch adds __log:= itself when it spawns (LocalProcess); the rest is equal
+        assert record["argv"][:-1] == expected["argv"]
+        assert record["argv"][-1].startswith("__log:=")
+        for key, value in expected["env"].items():
+            assert record["env"].get(key) == value, key
+    return True
