@@ -130,11 +130,7 @@ class Recorder:
         """Unsubscribe, write what is queued, close the bag (renaming it to its name)."""
         from orchestra.node import runtime
         self.stopping.set()
-        rt = runtime._runtime
-        if rt is not None:
-            rt.signal_shutdown("bag record done")
-            rt.wait_shutdown_done()
-            runtime._runtime = None
+        runtime.reset("bag record done")
         with self._cond:
             self._cond.notify_all()
         for thread in self._threads:

@@ -92,11 +92,7 @@ def _start_cli_node():
 
 def _stop_cli_node(reason: str) -> None:
     from orchestra.node import runtime
-    rt = runtime._runtime
-    if rt is not None:
-        rt.signal_shutdown(reason)
-        rt.wait_shutdown_done()
-        runtime._runtime = None
+    runtime.reset(reason)
 
 
 # --- node -------------------------------------------------------------------------------------
@@ -245,7 +241,8 @@ def _control(op: str, names: tuple[str, ...], force: bool = False, sig: str = ""
                                       for n in missing))
     answer: dict = {"ok": True, "done": []}
     if mine:
-        before = {n["name"]: n for n in launch["nodes"]} if launch else {}
+        assert launch is not None  # names are ours only when a launch answered
+        before = {n["name"]: n for n in launch["nodes"]}
         body: dict = {"op": op, "names": list(mine), "force": force}
         if sig:
             body["signal"] = sig
@@ -254,7 +251,8 @@ def _control(op: str, names: tuple[str, ...], force: bool = False, sig: str = ""
         except (OSError, ValueError) as exc:
             raise CommandFailed(f"the launch did not answer: {exc}") from None
         if not answer.get("ok"):
-            raise (_Unknown if answer.get("unknown") else CommandFailed)(answer.get("error"))
+            raise (_Unknown if answer.get("unknown") else CommandFailed)(
+                str(answer.get("error")))
         if op != "signal":
             _wait_settled(launch["socket"], [n for n, _ in answer["done"]], before, timeout)
     for name in foreign:

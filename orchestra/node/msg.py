@@ -27,6 +27,7 @@ class Message:
     """Base of every message class; fields are the class's ``__slots__``."""
 
     __slots__ = ("_connection_header",)
+    _connection_header: dict[str, str]  # set on received messages (the publisher's header)
     _type = ""
     _md5sum = ""
     _full_text = ""

@@ -19,13 +19,13 @@ import socket
 import sys
 import threading
 import time
-from collections.abc import Callable
-from typing import Any
+from collections.abc import Callable, Mapping
+from typing import TYPE_CHECKING, Any
 from urllib.parse import urlparse
 
 import yaml
 
-from orchestra.node import names, rostime, tcpros
+from orchestra.node import context, names, rostime, tcpros
 from orchestra.node.exceptions import (
     ROSException,
     ROSInitException,
@@ -33,8 +33,12 @@ from orchestra.node.exceptions import (
     TransportException,
 )
 from orchestra.node.masterapi import Master, MasterError
-from orchestra.node.topics import TopicManager
+from orchestra.node.topics import Publisher, Subscriber, TopicManager
 from orchestra.rpc import master_uri_from_env
+
+if TYPE_CHECKING:
+    from orchestra.node.services import Service, ServiceServer
+    from orchestra.node.slave import SlaveServer
 
 log = logging.getLogger(__name__)
 _UNSET = object()
@@ -133,10 +137,10 @@ class NodeRuntime:
         self.master = Master(master_uri, name)
         bind = host if host.startswith("127.") else "0.0.0.0"
         self.topics = TopicManager(self)
-        self.services: dict[str, Any] = {}
+        self.services: dict[str, ServiceServer] = {}
         self._services_lock = threading.Lock()
-        self._slave = None
-        self._tcpros = None
+        self._slave: SlaveServer | None = None
+        self._tcpros: TcprosServer | None = None
         self._host, self._bind = host, bind
         self._shutdown_requested = threading.Event()
         self._shutdown_reason = ""
@@ -147,20 +151,26 @@ class NodeRuntime:
         self._cleanup_lock = threading.RLock()
         self._hooks: list[Callable[..., Any]] = []
         self.params: dict[str, Any] = {}
+        # what init_node adds once the node is registered (see init_node)
+        self.rosout: Publisher | None = None
+        self.clock_sub: Subscriber | None = None
+        self.logger_services: list[Service] = []
 
     def start(self, xmlrpc_port: int = 0, tcpros_port: int = 0) -> None:
         """Open both servers (port 0 = any free port, the default) and start serving."""
         from orchestra.node.slave import SlaveServer
 
+        tcpros_server: TcprosServer | None = None
         try:
-            self._tcpros = TcprosServer(self, self._bind, self._host, tcpros_port)
-            self._slave = SlaveServer(self, self._bind, self._host, xmlrpc_port)
+            tcpros_server = TcprosServer(self, self._bind, self._host, tcpros_port)
+            slave = SlaveServer(self, self._bind, self._host, xmlrpc_port)
         except OSError as exc:
-            if self._tcpros is not None:
-                self._tcpros.stop()
+            if tcpros_server is not None:
+                tcpros_server.stop()
             raise ROSInitException(f"cannot open the node's ports on {self._bind}: {exc}") from exc
-        self._tcpros.start()
-        self._slave.start()
+        self._tcpros, self._slave = tcpros_server, slave
+        tcpros_server.start()
+        slave.start()
         rostime._set_shutdown_event(self._shutdown_requested)
 
     @property
@@ -169,6 +179,8 @@ class NodeRuntime:
 
     @property
     def tcpros_address(self) -> tuple[str, int]:
+        if self._tcpros is None:
+            raise ROSInitException("the node has not been started")
         return self._tcpros.host, self._tcpros.port
 
     # names ----------------------------------------------------------------------------------
@@ -207,7 +219,7 @@ class NodeRuntime:
             log.debug("%s %s failed: %s", method, name, exc)
 
     # services ---------------------------------------------------------------------------------
-    def add_service(self, server):
+    def add_service(self, server: ServiceServer) -> ServiceServer:
         with self._services_lock:
             if server.name in self.services:
                 raise ROSException(f"service {server.name} is already provided by this node")
@@ -221,7 +233,7 @@ class NodeRuntime:
             raise ROSException(f"cannot register service {server.name}: {exc}") from exc
         return server
 
-    def remove_service(self, server) -> None:
+    def remove_service(self, server: ServiceServer) -> None:
         with self._services_lock:
             if self.services.get(server.name) is not server:
                 return
@@ -270,6 +282,15 @@ class NodeRuntime:
             self._shutdown_requested.set()
             self._cleanup.start()
 
+    def spin(self) -> None:
+        """Block until the node is shut down (and its cleanup has finished)."""
+        try:
+            while not self._shutdown_requested.wait(0.5):
+                pass
+        except KeyboardInterrupt:
+            self.signal_shutdown("keyboard interrupt")
+        self.wait_shutdown_done()
+
     def wait_shutdown_done(self, timeout: float | None = 10.0) -> None:
         with self._cleanup_lock:
             thread = self._cleanup
@@ -293,6 +314,7 @@ class NodeRuntime:
 
 def _call_hook(hook: Callable[..., Any], reason: str) -> None:
     try:
+        params: Mapping[str, inspect.Parameter]
         try:
             params = inspect.signature(hook).parameters
         except (TypeError, ValueError):
@@ -307,14 +329,19 @@ def _call_hook(hook: Callable[..., Any], reason: str) -> None:
 
 # --- the process-wide node --------------------------------------------------------------------
 
-_runtime: NodeRuntime | None = None
-_init_lock = threading.Lock()
-
-
 def get_runtime() -> NodeRuntime:
-    if _runtime is None:
-        raise ROSInitException("init_node() has not been called in this process")
-    return _runtime
+    """The process's node (held by ``context``); ROSInitException before ``init_node``."""
+    return context.current()
+
+
+def reset(reason: str) -> None:
+    """Shut this process's node down and forget it, so ``init_node`` may run again (tools
+    that make a short-lived node per command)."""
+    rt = context.current_or_none()
+    if rt is not None:
+        rt.signal_shutdown(reason)
+        rt.wait_shutdown_done()
+        context.set_current(None)
 
 
 def _parse_master_uri(uri: str) -> str:
@@ -329,7 +356,6 @@ def init_node(name: str, argv: list[str] | None = None, anonymous: bool = False,
 
     When the parameter ``/use_sim_time`` is true (and not ``disable_rostime``), ROS time is
     the simulated time of ``/clock`` (rosgraph_msgs/Clock), as in rospy."""
-    global _runtime
     argv = list(sys.argv if argv is None else argv)
     parsed = names.parse_args(argv)
     special = parsed.special
@@ -342,17 +368,18 @@ def init_node(name: str, argv: list[str] | None = None, anonymous: bool = False,
         name = names.anonymous_name(name)
     namespace = names.make_global_ns(special.get("__ns") or os.environ.get("ROS_NAMESPACE") or "/")
     full_name = namespace + name
-    with _init_lock:
-        if _runtime is not None:
-            if _runtime.name == full_name:
+    with context.lock:
+        existing = context.current_or_none()
+        if existing is not None:
+            if existing.name == full_name:
                 return
-            raise ROSInitException(f"init_node() was already called as {_runtime.name}")
+            raise ROSInitException(f"init_node() was already called as {existing.name}")
         master_uri = _parse_master_uri(special.get("__master") or master_uri_from_env())
         remaps = names.resolve_remaps(parsed.remaps, namespace, full_name)
         host = _advertise_host(special, master_uri)
         runtime = NodeRuntime(full_name, namespace, master_uri, remaps, host, argv)
         runtime.start(xmlrpc_port, tcpros_port)
-        _runtime = runtime
+        context.set_current(runtime)
     _setup_logging(log_level)
     atexit.register(_at_exit)
     if not disable_signals and threading.current_thread() is threading.main_thread():
@@ -413,16 +440,17 @@ def _on_signal(signum, frame) -> None:
 def _at_exit() -> None:
     global _exiting
     _exiting = True
-    if _runtime is not None:
-        _runtime.signal_shutdown("process exit")
-        _runtime.wait_shutdown_done()
+    rt = context.current_or_none()
+    if rt is not None:
+        rt.signal_shutdown("process exit")
+        rt.wait_shutdown_done()
 
 
 # --- the rospy-style functions -----------------------------------------------------------------
 
 def is_initialized() -> bool:
     """Whether ``init_node`` has made this process a node (rospy.core.is_initialized)."""
-    return _runtime is not None
+    return context.current_or_none() is not None
 
 
 def get_name() -> str:
@@ -463,12 +491,14 @@ def myargv(argv: list[str] | None = None) -> list[str]:
 
 
 def is_shutdown() -> bool:
-    return _runtime is not None and _runtime.is_shutdown()
+    rt = context.current_or_none()
+    return rt is not None and rt.is_shutdown()
 
 
 def signal_shutdown(reason: str) -> None:
-    if _runtime is not None:
-        _runtime.signal_shutdown(reason)
+    rt = context.current_or_none()
+    if rt is not None:
+        rt.signal_shutdown(reason)
 
 
 def on_shutdown(h: Callable[..., Any]) -> None:
@@ -477,13 +507,7 @@ def on_shutdown(h: Callable[..., Any]) -> None:
 
 def spin() -> None:
     """Block until the node is shut down (and its cleanup has finished)."""
-    rt = get_runtime()
-    try:
-        while not rt._shutdown_requested.wait(0.5):
-            pass
-    except KeyboardInterrupt:
-        rt.signal_shutdown("keyboard interrupt")
-    rt.wait_shutdown_done()
+    get_runtime().spin()
 
 
 # params -------------------------------------------------------------------------------------------
@@ -667,9 +691,9 @@ def _log(level: int, msg: Any, args: tuple, kwargs: dict | None = None,
         return
     text = str(msg) % args if args else str(msg)
     logger.log(level, text, **kwargs)
-    rt = _runtime
-    pub = getattr(rt, "rosout", None) if rt is not None else None
-    if pub is None or rt.is_shutdown():
+    rt = context.current_or_none()
+    pub = rt.rosout if rt is not None else None
+    if rt is None or pub is None or rt.is_shutdown():
         return
     frame = inspect.currentframe()
     caller = frame
@@ -677,7 +701,7 @@ def _log(level: int, msg: Any, args: tuple, kwargs: dict | None = None,
         caller = caller.f_back if caller is not None else None
     try:
         from orchestra.node.rostime import Time
-        m = pub.data_class(level=_LEVELS[level][1], name=rt.name, msg=text,
+        m: Any = pub.data_class(level=_LEVELS[level][1], name=rt.name, msg=text,
                            file=caller.f_code.co_filename if caller else "",
                            function=caller.f_code.co_name if caller else "",
                            line=caller.f_lineno if caller else 0,

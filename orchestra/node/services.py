@@ -15,7 +15,7 @@ import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
-from orchestra.node import tcpros
+from orchestra.node import context, tcpros
 from orchestra.node.exceptions import (
     ROSException,
     ROSInterruptException,
@@ -142,9 +142,7 @@ class Service:
 
     def __init__(self, name: str, service_class: type[ServiceDefinition], handler: Callable,
                  **_ignored: Any):
-        from orchestra.node.runtime import get_runtime
-
-        self._rt = get_runtime()
+        self._rt = context.current()
         self.resolved_name = self.name = self._rt.resolve_name(name)
         self.service_class = service_class
         self.handler = handler
@@ -157,8 +155,7 @@ class Service:
     unregister = shutdown
 
     def spin(self) -> None:
-        from orchestra.node.runtime import spin
-        spin()
+        self._rt.spin()
 
 
 def _open(runtime_name: str, master, name: str, srv_class: type[ServiceDefinition],
@@ -196,9 +193,7 @@ class ServiceProxy:
 
     def __init__(self, name: str, service_class: type[ServiceDefinition],
                  persistent: bool = False, headers: dict | None = None):
-        from orchestra.node.runtime import get_runtime
-
-        self._rt = get_runtime()
+        self._rt = context.current()
         self.resolved_name = self.name = self._rt.resolve_name(name)
         self.service_class = service_class
         self.request_class = service_class._request_class
@@ -258,9 +253,7 @@ class ServiceProxy:
 def wait_for_service(service: str, timeout: float | None = None) -> None:
     """Block until ``service`` is registered and answers a probe; ``ROSException`` on
     timeout (``timeout``: seconds or a Duration, None to wait for ever)."""
-    from orchestra.node.runtime import get_runtime
-
-    rt = get_runtime()
+    rt = context.current()
     resolved = rt.resolve_name(service)
     if timeout is not None and not isinstance(timeout, (int, float)):
         timeout = timeout.to_sec()

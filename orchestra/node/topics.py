@@ -16,9 +16,9 @@ import socket
 import struct
 import threading
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
-from orchestra.node import tcpros
+from orchestra.node import context, tcpros
 from orchestra.node.exceptions import ROSException, TransportException
 from orchestra.node.masterapi import MasterError, raw_call
 from orchestra.node.msg import AnyMsg, Message
@@ -29,6 +29,9 @@ if TYPE_CHECKING:
     from orchestra.node.runtime import NodeRuntime
 
 log = logging.getLogger(__name__)
+
+# (Subscription has a property named ``type``, which hides the builtin in its body)
+MessageClass = type[Message]
 
 RECONNECT_MIN = 0.05
 _RECV_MIN = 65536  # receive buffer size of a connection
@@ -127,7 +130,7 @@ class Publication:
         self.queue_size = queue_size
         self.lock = threading.Lock()
         self.connections: list[OutConnection] = []
-        self.latched: bytes | None = None
+        self.latched: bytes | bytearray | None = None
         self.handles = 0
         self.seq = 0
         self.messages = 0
@@ -155,7 +158,8 @@ class Publication:
         with self.lock:
             self.seq += 1
             if msg._has_header:
-                msg.header.seq = self.seq & 0xFFFFFFFF  # uint32 on the wire
+                # a generated field (the class has it when _has_header says so)
+                cast(Any, msg).header.seq = self.seq & 0xFFFFFFFF  # uint32 on the wire
             data = msg.serialize_bytes()
             if self.latch:
                 self.latched = data
@@ -225,11 +229,9 @@ class Publisher:
 
     def __init__(self, topic: str, msg_class: type[Message], queue_size: int | None = 10,
                  latch: bool = False, subscriber_listener: Any = None, **_ignored: Any):
-        from orchestra.node.runtime import get_runtime
-
         if not (isinstance(msg_class, type) and issubclass(msg_class, Message)):
             raise ValueError(f"Publisher needs a message class, not {msg_class!r}")
-        self._rt = get_runtime()
+        self._rt = context.current()
         self.resolved_name = self.name = self._rt.resolve_name(topic)
         self.data_class = msg_class
         self.type = msg_class._type
@@ -419,7 +421,7 @@ class Subscription:
         self.lock = threading.Lock()
         # held while callbacks run; re-entrant so a callback may subscribe to its own topic
         self.callback_lock = threading.RLock()
-        self.callbacks: list[tuple[Callable, Any, type[Message]]] = []
+        self.callbacks: list[tuple[Callable, Any, MessageClass]] = []
         self.connections: dict[str, InConnection] = {}
         self.closed = False
 
@@ -427,7 +429,7 @@ class Subscription:
     def type(self) -> str:
         return self.msg_class._type
 
-    def add_callback(self, cb: Callable, cb_args: Any, cls: type[Message]) -> None:
+    def add_callback(self, cb: Callable, cb_args: Any, cls: MessageClass) -> None:
         """Add a callback; it is first given the newest message of each latched publisher
         already received (rospy's rule), then every message that arrives.
 
@@ -464,7 +466,7 @@ class Subscription:
             self._dispatch(data, header, origin, self.callbacks)
 
     def _dispatch(self, data: bytes, header: dict[str, str], origin: str,
-                  callbacks: list[tuple[Callable, Any, type[Message]]]) -> None:
+                  callbacks: list[tuple[Callable, Any, MessageClass]]) -> None:
         decoded: dict[type, Message | None] = {}
         for cb, args, cls in callbacks:
             if cls not in decoded:
@@ -528,11 +530,9 @@ class Subscriber:
 
     def __init__(self, topic: str, msg_class: type[Message], callback: Callable | None = None,
                  callback_args: Any = None, queue_size: int | None = 10, **_ignored: Any):
-        from orchestra.node.runtime import get_runtime
-
         if not (isinstance(msg_class, type) and issubclass(msg_class, Message)):
             raise ValueError(f"Subscriber needs a message class, not {msg_class!r}")
-        self._rt = get_runtime()
+        self._rt = context.current()
         self.resolved_name = self.name = self._rt.resolve_name(topic)
         self.data_class = msg_class
         self.type = msg_class._type
@@ -702,9 +702,9 @@ class TopicManager:
                     info.append([c.id, c.peer, "o", "TCPROS", topic, True,
                                  describe_socket(c.sock)])
             for topic, sub in self.subscriptions.items():
-                for c in list(sub.connections.values()):
-                    info.append([c.id, c.uri, "i", "TCPROS", topic, c.connected,
-                                 describe_socket(c.sock)])
+                for conn in list(sub.connections.values()):
+                    info.append([conn.id, conn.uri, "i", "TCPROS", topic, conn.connected,
+                                 describe_socket(conn.sock)])
         return info
 
 
