@@ -8,6 +8,7 @@ mentions ``m``.
 from __future__ import annotations
 
 import ast
+from typing import Any
 
 from orchestra.bag.expression import Expression, ExpressionError, compile_expression
 from orchestra.bag.records import Connection
@@ -27,7 +28,7 @@ def filter_bag(src: str, dst: str, expr: Expression, compression: str = "none") 
     needs_message = any(isinstance(n, ast.Name) and n.id == "m" for n in ast.walk(expr.tree))
 
     def keep(conn: Connection, stamp: int, data: bytes) -> bool:
-        values = {"topic": conn.topic, "t": Time(stamp // 1_000_000_000,
+        values: dict[str, Any] = {"topic": conn.topic, "t": Time(stamp // 1_000_000_000,
                                                  stamp % 1_000_000_000)}
         if needs_message:
             values["m"] = decoder.decode(conn.header, data)
