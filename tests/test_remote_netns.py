@@ -159,6 +159,16 @@ def test_remote_nodes_run_remotely_respawn_and_a_required_death_stops_both_sides
     assert netns_of(found["boss"][0]["pid"]) == remote_ns
     assert netns_of(found["here"][0]["pid"]) == local_ns
     wait_for(lambda: len(run.records("crashy")) >= 2, timeout=20)     # crashed, respawned
+    status = bed.in_local([sys.executable, "-m", "orchestra", "status", "--json"],
+                          env=run.env, capture_output=True, text=True, timeout=30)
+    assert status.returncode == 0, status.stderr
+    launches = json.loads(status.stdout)
+    assert len(launches) == 1, status.stdout
+    nodes = {n["name"]: n for n in launches[0]["nodes"]}
+    talker = nodes["/talker"]            # its pid/memory on ITS machine, not the local relay's
+    assert (talker["machine"], talker["pid"]) == ("far", found["talker"][0]["pid"]), talker
+    assert talker["rss"] and talker["rss"] > 0
+    assert "machine" not in nodes["/here"]
     (run.out / "boss.die").write_text("")
     output, _ = proc.communicate(timeout=40)
     text = output.decode(errors="replace")

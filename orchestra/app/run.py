@@ -38,6 +38,7 @@ from orchestra.app.master import (
 )
 from orchestra.app.options import RunOptions
 from orchestra.launch.plan import LaunchPlan, Node
+from orchestra.remote.session import RemoteSession
 from orchestra.rpc import TRANSPORT_ERRORS, proxy
 from orchestra.supervise import control
 from orchestra.supervise.output import Screen, prepare_run_log_dir
@@ -116,6 +117,7 @@ class LaunchRun:
         self.master: MasterConnection | None = None
         self.log_dir: str | None = None
         self.supervisor: Supervisor | None = None
+        self.remote: RemoteSession | None = None     # the run's remote machines, if any
         self.report: RunReport | None = None
         self._watchdog: Watchdog | None = None
         self._thread: threading.Thread | None = None
@@ -326,7 +328,7 @@ class LaunchRun:
         try:
             session = None
             if remote and not opts.local:   # all-or-nothing: every machine ready, or exit 2
-                session = open_remote(plan, remote, watchdog)
+                self.remote = session = open_remote(plan, remote, watchdog)
                 self._closers.append(session.close)
             self.master = master = connect_master(opts, self._report,
                                                   public=session is not None)
@@ -370,7 +372,9 @@ class LaunchRun:
                 "launch_files": list(self.plan.files_loaded), "log_dir": self.log_dir}
 
         def make_snapshot() -> dict[str, Any]:
-            return snapshot(supervisor.procs, stats, info)
+            document = snapshot(supervisor.procs, stats, info)
+            # remote nodes: their pid/CPU/memory on their machine, not their local client's
+            return self.remote.annotate(document) if self.remote is not None else document
 
         number = next(_RUNS)
         path = os.path.join(runtime_dir(), f"{os.getpid()}{f'-{number}' if number else ''}.sock")

@@ -65,8 +65,10 @@ from orchestra.supervise.reaper import (
     marked_pids,
     setpriv_prefix,
 )
+from orchestra.supervise.status import ProcessStats
 
 _READ = 65536
+STATS_REQUEST = b"stats\n"      # instead of a node payload: the agent answers with stats
 
 def node_environment(base: Mapping[str, str], node: Node, master_uri: str, address: str,
                      mark: str | None, executable: str) -> dict[str, str]:
@@ -101,8 +103,10 @@ class NodeRun:
     everything); ``kinds`` maps each of the node's pipes to its frame kind.
     """
 
-    def __init__(self, argv: list[str], env: dict[str, str], cwd: str, log_base: str,
-                 sigint_timeout: float, sigterm_timeout: float, conn: socket.socket):
+    def __init__(self, name: str, argv: list[str], env: dict[str, str], cwd: str,
+                 log_base: str, sigint_timeout: float, sigterm_timeout: float,
+                 conn: socket.socket):
+        self.name = name
         os.makedirs(cwd, exist_ok=True)
         # the node dies with the agent, as local nodes with orchestra (reaper.py: setpriv
         # when present, ~1 ms; else a preexec_fn, which forks the whole interpreter)
@@ -237,6 +241,7 @@ class Agent:
         self.poller = select.poll()
         self.handlers: dict[int, Callable[[int, int], None]] = {}
         self.runs: dict[int, NodeRun] = {}
+        self.stats = ProcessStats()
         self.stopping = False
         self.poll_exits = False      # no pidfds here (Linux < 5.3): look for exits every 0.2 s
 
@@ -302,6 +307,9 @@ class Agent:
         if not data.endswith(b"\n"):
             conn.close()
             return
+        if data == STATS_REQUEST:
+            self._answer_stats(conn)
+            return
         try:
             run = self._start(payload.decode(data.decode().strip()), conn)
         except (OrchestraError, OSError, ValueError, KeyError) as exc:
@@ -323,6 +331,19 @@ class Agent:
             self.poll_exits = True
         if self.stopping:
             run.request_stop()
+
+    def _answer_stats(self, conn: socket.socket) -> None:
+        """For ``orchestra status``: each running node's pid, CPU% and RSS on this machine."""
+        report = {}
+        for pid, run in self.runs.items():
+            cpu, rss = self.stats.sample(pid)
+            report[run.name] = {"pid": pid, "cpu_percent": cpu, "rss": rss}
+        self.stats.forget_except(set(self.runs))
+        try:
+            conn.sendall(json.dumps(report).encode())
+        except OSError:
+            pass
+        conn.close()
 
     def _on_conn(self, run: NodeRun, fd: int, events: int) -> None:
         """The node's connection: EOF (or an error) means its local process is gone."""
@@ -350,7 +371,7 @@ class Agent:
         argv = node_argv(node, exe, log_file=os.path.join(log_dir, data["log_name"] + ".log"))
         env = node_environment(os.environ, node, data["master_uri"], self.address, self.mark,
                                sys.executable)
-        return NodeRun(argv, env, node_cwd(node, exe, env),
+        return NodeRun(node.full_name, argv, env, node_cwd(node, exe, env),
                        os.path.join(log_dir, data["log_name"]), float(data["sigint_timeout"]),
                        float(data["sigterm_timeout"]), conn)
 

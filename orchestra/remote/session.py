@@ -43,10 +43,12 @@ import time
 import urllib.parse
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 from orchestra.errors import Location, OrchestraError
 from orchestra.launch.plan import Machine, Node
 from orchestra.remote import payload, ssh
+from orchestra.remote.agent import STATS_REQUEST
 from orchestra.supervise.reaper import setpriv_prefix
 
 logger = logging.getLogger(__name__)
@@ -258,6 +260,36 @@ class RemoteSession:
                 "log_name": log_name, "sigint_timeout": sigint_timeout,
                 "sigterm_timeout": sigterm_timeout}
         return [sys.executable, "-I", "-S", CLIENT, entry.local_socket, payload.encode(data)]
+
+    def remote_stats(self, timeout: float = 0.5) -> dict[str, dict[str, Any]]:
+        """{node full name: {machine, pid, cpu_percent, rss}} as each machine's agent sees
+        its nodes (for ``orchestra status``); a machine that does not answer in ``timeout``
+        is left out."""
+        found: dict[str, dict[str, Any]] = {}
+        for name, entry in self.machines.items():
+            try:
+                with socket.socket(socket.AF_UNIX) as sock:
+                    sock.settimeout(timeout)
+                    sock.connect(entry.local_socket)
+                    sock.sendall(STATS_REQUEST)
+                    data = b""
+                    while chunk := sock.recv(65536):
+                        data += chunk
+                report = json.loads(data)
+            except (OSError, ValueError):
+                continue
+            for node, values in report.items():
+                found[node] = {"machine": name, **values}
+        return found
+
+    def annotate(self, snapshot: dict[str, Any]) -> dict[str, Any]:
+        """A status snapshot with the remote nodes' pid/CPU/RSS from their machines."""
+        remote = self.remote_stats()
+        for entry in snapshot.get("nodes", ()):
+            values = remote.get(entry.get("name"))
+            if values is not None and entry.get("pid") is not None:
+                entry.update(values)
+        return snapshot
 
     # ------------------------------------------------------------------ after the run
 
