@@ -18,6 +18,8 @@ from http.client import HTTPConnection, HTTPException
 from typing import Any, cast
 from xmlrpc.server import SimpleXMLRPCRequestHandler, SimpleXMLRPCServer
 
+from orchestra.errors import OrchestraError
+
 log = logging.getLogger(__name__)
 
 DEFAULT_PORT = 11311
@@ -26,6 +28,12 @@ DEFAULT_MASTER_URI = f"http://localhost:{DEFAULT_PORT}/"  # roscore's default
 # what goes wrong on the wire when nobody (or something odd) answers
 TRANSPORT_ERRORS: tuple[type[Exception], ...] = (
     OSError, HTTPException, xmlrpc.client.ProtocolError, xmlrpc.client.ResponseError)
+
+
+class MasterUnreachable(OrchestraError):
+    """No master answers at the given URI (a user-facing error: start one, or fix the URI)."""
+
+    exit_code = 1
 
 
 def master_uri_from_env(environ: Mapping[str, str] | None = None) -> str:

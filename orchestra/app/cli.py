@@ -157,7 +157,7 @@ def serve_plan(plan: Any, options: Any, cli: dict[str, Any] | None = None) -> in
     import socket
 
     from orchestra.app.run import LaunchRun
-    from orchestra.supervise.output import log_dir_root
+    from orchestra.rosdirs import log_dir_root
 
     cli = cli or {}
     if cli.get("socket_timeout") is not None:
@@ -289,7 +289,7 @@ def _launch_core(ctx: click.Context, words: tuple[str, ...], run_opts: dict[str,
     """``launch --core``: ``orchestra core`` under roslaunch's rules (no files, no --wait,
     and a pid file, by default ``$ROS_HOME/roscore-<port>.pid``, while it runs)."""
     from orchestra.master import master_uri_from_env, port_from_uri
-    from orchestra.supervise.command import ros_home
+    from orchestra.rosdirs import ros_home
 
     if words:
         raise click.UsageError("launch files are not allowed with --core")

@@ -14,7 +14,7 @@ from orchestra.errors import OrchestraError
 from orchestra.launch.plan import LaunchPlan, Node
 from orchestra.remote.locality import UnresolvableAddress, is_local_machine
 from orchestra.remote.session import RemoteSession
-from orchestra.supervise.command import ros_home
+from orchestra.rosdirs import ros_home
 from orchestra.supervise.process import ProcessSpec
 from orchestra.supervise.reaper import Watchdog
 from orchestra.supervise.specs import SpecOptions, build_specs, node_location

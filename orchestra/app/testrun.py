@@ -29,7 +29,8 @@ from orchestra.app.options import RunOptions
 from orchestra.app.run import LaunchRun
 from orchestra.errors import OrchestraError
 from orchestra.launch.plan import LaunchPlan, Test
-from orchestra.supervise.command import find_node_executable, ros_home
+from orchestra.rosdirs import ros_home
+from orchestra.supervise.command import find_node_executable
 from orchestra.supervise.output import Screen
 from orchestra.supervise.reaper import (
     MARK_VARIABLE,

@@ -16,6 +16,7 @@ from orchestra.rpc import (
     DEFAULT_MASTER_URI,
     DEFAULT_PORT,
     TRANSPORT_ERRORS,
+    MasterUnreachable,
     master_uri_from_env,
     multicall_results,
     proxy,
@@ -26,12 +27,6 @@ __all__ = [
     "DEFAULT_MASTER_URI", "DEFAULT_PORT", "TRANSPORT_ERRORS", "MasterUnreachable",
     "master_is_up", "master_uri_from_env", "port_from_uri", "proxy", "upload_params",
 ]
-
-
-class MasterUnreachable(OrchestraError):
-    """No master answers at the given URI."""
-
-    exit_code = 1
 
 
 def port_from_uri(uri: str) -> int:

@@ -22,7 +22,7 @@ class GraphError(OrchestraError):
 
 def master_call(master_uri: str, method: str, *args):
     """A master call from the CLI: unreachable master -> MasterUnreachable (exit 1)."""
-    from orchestra.master import MasterUnreachable
+    from orchestra.rpc import MasterUnreachable
 
     try:
         code, msg, value = raw_call(master_uri, method, CALLER, *args, timeout=5.0)

@@ -15,10 +15,15 @@ from typing import Any
 import click
 
 from orchestra.errors import Location, OrchestraError
-from orchestra.master.client import MasterUnreachable
 from orchestra.params.dump import dump_yaml, format_get
 from orchestra.params.tree import SEP, ParamValueError, canonical, check_value, ns_join, resolve
-from orchestra.rpc import TRANSPORT_ERRORS, master_uri_from_env, multicall_results, proxy
+from orchestra.rpc import (
+    TRANSPORT_ERRORS,
+    MasterUnreachable,
+    master_uri_from_env,
+    multicall_results,
+    proxy,
+)
 
 NS_KEY = "_ns"  # a YAML document's own namespace, as rosparam reads it
 

@@ -24,6 +24,7 @@ from typing import Any
 from orchestra.errors import Location, OrchestraError
 from orchestra.launch.plan import LaunchPlan, Node
 from orchestra.packages import find_executable
+from orchestra.rosdirs import ros_home
 
 
 class ExecutableNotFound(OrchestraError):
@@ -93,12 +94,6 @@ def node_env(node: Node, master_uri: str | None = None) -> dict[str, str]:
     for name, value in node.env_args:
         env[name] = value
     return env
-
-
-def ros_home(environ: Mapping[str, str] | None = None) -> str:
-    """``$ROS_HOME``, else ``~/.ros`` (rospkg.get_ros_home)."""
-    env = os.environ if environ is None else environ
-    return env.get("ROS_HOME") or os.path.join(os.path.expanduser("~"), ".ros")
 
 
 def node_cwd(node: Node, executable: str, environ: Mapping[str, str] | None = None) -> str:

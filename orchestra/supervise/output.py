@@ -14,21 +14,13 @@ import sys
 import zlib
 from typing import BinaryIO
 
+from orchestra.rosdirs import log_dir_root
 from orchestra.supervise.process import OutputMode
 
 MAX_LINE = 65536   # console bytes held back waiting for a newline
 RECENT_LINES = 200  # per node, for the interactive view and exit reasons
 
 _COLOURS = (31, 32, 33, 34, 35, 36, 91, 92, 93, 94, 95, 96)
-
-
-def log_dir_root(environ: dict[str, str] | None = None) -> str:
-    """``$ROS_LOG_DIR``, else ``$ROS_HOME/log``, else ``~/.ros/log`` (rospkg.get_log_dir)."""
-    env = os.environ if environ is None else environ
-    if env.get("ROS_LOG_DIR"):
-        return env["ROS_LOG_DIR"]
-    home = env.get("ROS_HOME") or os.path.join(os.path.expanduser("~"), ".ros")
-    return os.path.join(home, "log")
 
 
 def prepare_run_log_dir(run_id: str, environ: dict[str, str] | None = None) -> str:

@@ -8,8 +8,7 @@ from collections.abc import Mapping
 
 from orchestra.packages import PackageNotFound, get_index
 from orchestra.packages.deps import all_packages_graph, build_graph
-from orchestra.supervise.command import ros_home
-from orchestra.supervise.output import log_dir_root
+from orchestra.rosdirs import log_dir_root, ros_home
 
 __all__ = ["ResourceNotFound", "RosPack", "get_log_dir", "get_ros_home",
            "get_ros_package_path"]
