@@ -1,4 +1,5 @@
 """Tag rules of the interpreter, on small launch files written for each behaviour."""
+import re
 import sys
 
 import pytest
@@ -231,3 +232,23 @@ def test_include_chain_deeper_than_the_bound_is_a_located_error(write):
     assert info.value.location.line == 1
     from orchestra.errors import MAX_MESSAGE
     assert len(info.value.message) <= MAX_MESSAGE + len("... (100000 chars)")
+
+
+@pytest.mark.parametrize("element", [
+    '<node name="n" pkg="p" type="t" respawn="{v}"/>',
+    '<node name="n" pkg="p" type="t" respawn_delay="{v}"/>',
+    '<param name="p" type="int" value="{v}"/>',
+])
+def test_a_huge_value_is_clipped_in_the_error_with_its_length(write, element):
+    huge = "x" * 2**20
+    with pytest.raises(OrchestraError) as info:
+        launch(write, element.format(v=huge))
+    text = str(info.value)
+    assert len(text) < 600 and re.search(r"\.\.\. \(10485\d\d chars\)", text)
+    assert info.value.location.line == 1
+
+
+def test_clip_keeps_short_text_and_notes_the_length_of_long_text():
+    from orchestra.errors import clip
+    assert clip("short") == "short"
+    assert clip("y" * 1000, 10) == "yyyyyyyyyy... (1000 chars)"

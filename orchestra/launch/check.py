@@ -160,9 +160,8 @@ def _arg_references(value: str) -> Iterator[str]:
 
 
 def _eval_references(expr: str) -> Iterator[str]:
-    try:
-        tree = ast.parse(expr.strip(), mode="eval")
-    except SyntaxError:
+    tree = evaluate.parse_tree(expr)
+    if tree is None:
         return
     bound = {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)
              and isinstance(n.ctx, ast.Store)}

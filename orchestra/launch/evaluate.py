@@ -30,6 +30,7 @@ import ast
 import builtins
 import math
 import re
+import warnings
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -634,7 +635,10 @@ def _parse(expr: str) -> ast.Expression:
         # roslaunch's own rule, kept so a file orchestra accepts is one roslaunch accepts
         raise _Refused("double underscores are not allowed")
     try:
-        return ast.parse(expr.strip(), mode="eval")
+        with warnings.catch_warnings():
+            # '1if x else 2' parses with a SyntaxWarning: not a line for the user's console
+            warnings.simplefilter("ignore", SyntaxWarning)
+            return ast.parse(expr.strip(), mode="eval")
     except SyntaxError as exc:
         raise _Refused(f"not a valid expression: {exc.msg}") from None
     except (RecursionError, MemoryError):
@@ -656,6 +660,14 @@ def _validate(tree: ast.Expression) -> None:
                                "str method")
             if node.attr not in STR_METHODS:
                 raise _Refused(f"'{node.attr}' is not an allowed str method")
+
+
+def parse_tree(expr: str) -> ast.Expression | None:
+    """The AST of ``expr``, or None when it is not an expression (nothing is evaluated)."""
+    try:
+        return _parse(expr)
+    except _Refused:
+        return None
 
 
 def problem(expr: str) -> str | None:

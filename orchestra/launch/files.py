@@ -8,9 +8,13 @@ to its own directory is read through.
 """
 from __future__ import annotations
 
+import errno
 import os
+import stat
 
 _MAX_STUB = 1024
+# The largest file a launch file may have read (launch, rosparam, textfile, binfile).
+MAX_FILE_BYTES = 256 * 2**20
 _MAX_HOPS = 8
 
 
@@ -28,11 +32,22 @@ def _stub_target(path: str, data: bytes) -> str | None:
         else None
 
 
+def _read_regular(path: str) -> bytes:
+    """A regular file's bytes, at most ``MAX_FILE_BYTES``: a launch file naming /dev/zero or a
+    FIFO must get an error, not exhaust memory or block forever."""
+    if not stat.S_ISREG(os.stat(path).st_mode):
+        raise OSError(errno.EINVAL, "not a regular file", path)
+    with open(path, "rb") as fh:
+        data = fh.read(MAX_FILE_BYTES + 1)
+    if len(data) > MAX_FILE_BYTES:
+        raise OSError(errno.EFBIG, f"larger than {MAX_FILE_BYTES // 2**20} MiB", path)
+    return data
+
+
 def read_bytes(path: str) -> bytes:
     """The content of ``path``, read through symlink stubs (OSError if unreadable)."""
     for _ in range(_MAX_HOPS):
-        with open(path, "rb") as fh:
-            data = fh.read()
+        data = _read_regular(path)
         target = _stub_target(path, data)
         if target is None:
             return data

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from typing import Any
 
+from orchestra.errors import clip
+
 PARAM_TYPES = ("auto", "str", "string", "int", "double", "bool", "boolean", "yaml")
 
 
@@ -26,17 +28,18 @@ def convert_value(value: str, type_: str) -> Any:
         return value
     if type_ in ("str", "string"):
         return value
-    if type_ == "int":
-        return int(value)
-    if type_ == "double":
-        return float(value)
+    if type_ in ("int", "double"):
+        try:
+            return int(value) if type_ == "int" else float(value)
+        except ValueError:
+            raise ValueError(f"{clip(repr(value))} is not an '{type_}' value") from None
     if type_ in ("bool", "boolean"):
         lowered = value.lower().strip()
         if lowered in ("true", "1"):
             return True
         if lowered in ("false", "0"):
             return False
-        raise ValueError(f"{value!r} is not a '{type_}' value (true/false/1/0)")
+        raise ValueError(f"{clip(repr(value))} is not a '{type_}' value (true/false/1/0)")
     if type_ == "yaml":
         from orchestra.params.yaml import load_yaml_value
         return load_yaml_value(value, "<yaml param>")
@@ -54,7 +57,7 @@ def bool_attribute(value: str | None, default: bool, label: str) -> bool:
         return False
     if not value:
         raise ValueError(f"bool value for {label} must be non-empty")
-    raise ValueError(f"invalid bool value for {label}: {value}")
+    raise ValueError(f"invalid bool value for {label}: {clip(value)}")
 
 
 _SIZE_UNITS = {"": 1, "b": 1, "k": 1000, "kb": 1000, "kib": 1024, "m": 1000**2, "mb": 1000**2,
@@ -71,7 +74,7 @@ def size_attribute(value: str | None, default: int | None, label: str) -> int | 
     try:
         size = float(number) * _SIZE_UNITS[unit]
     except (KeyError, ValueError):
-        raise ValueError(f"invalid size for {label}: {value!r} (bytes, or a number with "
+        raise ValueError(f"invalid size for {label}: {clip(repr(value))} (bytes, or a number with "
                          "kB/MB/GB/KiB/MiB/GiB)") from None
     return int(size)
 
@@ -84,4 +87,4 @@ def float_attribute(value: str | None, default: float, label: str) -> float:
     try:
         return float(value)
     except ValueError:
-        raise ValueError(f"invalid float value for {label}: {value}") from None
+        raise ValueError(f"invalid float value for {label}: {clip(value)}") from None
