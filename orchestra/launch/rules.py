@@ -16,7 +16,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
 
-from orchestra.errors import Location, OrchestraError
+from orchestra.errors import Location, OrchestraError, clip
 from orchestra.launch.plan import OUTPUT_MODES
 from orchestra.launch.values import PARAM_TYPES, bool_attribute, convert_value, size_attribute
 
@@ -49,13 +49,13 @@ def _float(text: str, label: str) -> float:
     try:
         return float(text)
     except ValueError:
-        raise ValueError(f"invalid float value for {label}: {text}") from None
+        raise ValueError(f"invalid float value for {label}: {clip(text)}") from None
 
 
 def _non_negative(text: str, label: str) -> float:
     value = _float(text, label)
     if value < 0:
-        raise ValueError(f"must not be negative: {text}")
+        raise ValueError(f"must not be negative: {clip(text)}")
     return value
 
 
@@ -69,9 +69,9 @@ def _positive(text: str, label: str) -> float:
     try:
         value = float(text)
     except ValueError:
-        raise ValueError(f"must be a number: [{text}]") from None
+        raise ValueError(f"must be a number: [{clip(text)}]") from None
     if value <= 0:
-        raise ValueError(f"must be a positive number: [{text}]")
+        raise ValueError(f"must be a positive number: [{clip(text)}]")
     return value
 
 
@@ -79,14 +79,14 @@ def _int(text: str, label: str) -> int:
     try:
         return int(text)
     except ValueError:
-        raise ValueError(f"must be a number: [{text}]") from None
+        raise ValueError(f"must be a number: [{clip(text)}]") from None
 
 
 def _port(text: str, label: str) -> int:
     try:
         return int(text or "22")
     except ValueError:
-        raise ValueError(f"not a port number: {text}") from None
+        raise ValueError(f"not a port number: {clip(text)}") from None
 
 
 def _choice(*choices: str, fold: bool = False, empty: str | None = None
@@ -99,7 +99,7 @@ def _choice(*choices: str, fold: bool = False, empty: str | None = None
             return empty
         if value not in choices:
             shown = ", ".join(f"'{c}'" for c in choices)
-            raise ValueError(f"must be one of {shown} (not '{text}')")
+            raise ValueError(f"must be one of {shown} (not '{clip(text)}')")
         return value
     return parse
 
