@@ -436,3 +436,34 @@ def test_kill_9_of_the_recorder_leaves_a_bag_that_reindex_repairs(master, tmp_pa
         got = [d for _, _, d in r.messages()]
     assert len(got) > 500
     assert got == [_string(f"n {i}") for i in range(len(got))]
+
+
+def test_play_on_a_terminal_pauses_with_space_and_steps_with_s(master, tmp_path):
+    import pty
+    bag = tmp_path / "timed.bag"
+    _timed_bag(bag)
+    env = _env(master)
+    sub = _start([sys.executable, str(FIXTURES / "stamp_sub.py"), "/timed"], env)
+    keys, tty = pty.openpty()
+    play = subprocess.Popen([sys.executable, "-m", "orchestra", "bag", "play", "--pause",
+                             "-d", "0", "--wait-for-subscribers", str(bag)], env=env,
+                            stdin=tty, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    try:
+        sub.ready(timeout=20)
+        sub.expect(lambda d: d.get("connected"), timeout=20)
+        for expected in ("n 0", "n 1"):
+            os.write(keys, b"s")
+            assert sub.expect(lambda d: "data" in d, timeout=10)["data"] == expected
+        with pytest.raises(AssertionError):  # paused: nothing more comes
+            sub.expect(lambda d: "data" in d, timeout=0.6)
+        os.write(keys, b" ")
+        rest = [sub.expect(lambda d: "data" in d, timeout=10)["data"] for _ in range(29)]
+        assert rest == [f"n {i}" for i in range(2, 31)]
+        assert play.wait(timeout=20) == 0, play.stderr.read() if play.stderr else ""
+    finally:
+        play.kill()
+        play.wait()
+        sub.kill()
+        os.close(keys)
+        os.close(tty)
+

@@ -5,12 +5,18 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
 from orchestra.bag.writer import BagWriter
 from orchestra.node.msg import get_message_class
 from orchestra.plot.series import SpecError, parse_path, parse_spec
+
+sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
+from harness import NodeProcess  # noqa: E402
+
+HERE = Path(__file__).resolve().parent
 
 T0 = 1_700_000_000 * 10**9
 C0 = (0x1F / 255, 0x77 / 255, 0xB4 / 255)  # matplotlib's first line colour
@@ -91,3 +97,21 @@ def test_plot_cli_writes_a_picture_from_a_bag_and_rejects_bad_specs(tmp_path):
         assert len(bad.stderr.strip().splitlines()) == 1
     nodisplay = subprocess.run(run + ["/value/data"], capture_output=True, text=True, env=env)
     assert nodisplay.returncode == 2 and "--out" in nodisplay.stderr
+
+
+def test_plot_live_topic_to_a_picture(master, tmp_path):
+    env = dict(os.environ, ROS_MASTER_URI=master.uri, PYTHONUNBUFFERED="1")
+    env.pop("DISPLAY", None)
+    env.pop("ROS_NAMESPACE", None)
+    pub = NodeProcess([sys.executable, str(HERE / "node_fixtures" / "pub.py"), "/value",
+                       "std_msgs/Float64", "data: $N", "--rate", "50"], env)
+    try:
+        pub.ready(timeout=20)
+        out = tmp_path / "live.png"
+        proc = subprocess.run([sys.executable, "-m", "orchestra", "plot", "/value/data",
+                               "--out", str(out), "--duration", "1.5"], capture_output=True,
+                              text=True, env=env, timeout=60)
+        assert proc.returncode == 0 and "no data" not in proc.stderr, proc.stderr
+        assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    finally:
+        pub.kill()

@@ -139,6 +139,9 @@ def _plot_live(specs: tuple[str, ...], out: str | None, duration: float, title: 
         except KeyboardInterrupt:
             pass
         source.refresh()
+        for s in series:
+            if not s.times:
+                click.echo(f"warning: no data for {s.label} in {duration:g} s", err=True)
         figure.save(series, out, title)
     finally:
         _stop_cli_node("plot done")
