@@ -183,6 +183,13 @@ def test_remote_nodes_run_remotely_respawn_and_a_required_death_stops_both_sides
 def test_remote_argv_env_are_roslaunchs_and_sigint_stops_both_sides(bed, run):
     proc = run.start()
     found = wait_started(run)
+    first = found["talker"][0]["pid"]
+    restart = bed.in_local([sys.executable, "-m", "orchestra", "node", "restart", "/talker"],
+                           env=run.env, capture_output=True, text=True, timeout=60)
+    assert restart.returncode == 0, restart.stdout + restart.stderr   # live control works too
+    again = wait_for(lambda: [r for r in run.records("talker") if r["pid"] != first])
+    assert not os.path.exists(f"/proc/{first}")
+    assert netns_of(again[0]["pid"]) == bed.netns_inode(bed.remote_ns)
     proc.send_signal(signal.SIGINT)
     output, _ = proc.communicate(timeout=30)
     assert proc.returncode == 0, output.decode(errors="replace")
