@@ -80,8 +80,11 @@ def main(argv: list[str] | None = None) -> None:
     except OrchestraError as exc:
         click.echo(f"orchestra: error: {exc}", err=True)
         sys.exit(exc.exit_code)
-    except click.exceptions.Abort:
-        click.echo("Aborted.", err=True)
+    except click.exceptions.Abort as exc:
+        # Ctrl-C is how long-running commands (topic hz/echo, launch) are ended: quietly,
+        # as the ROS tools do; "Aborted." is for a declined prompt
+        if not isinstance(exc.__cause__, KeyboardInterrupt):
+            click.echo("Aborted.", err=True)
         sys.exit(130)
     except click.ClickException as exc:
         exc.show()

@@ -357,3 +357,10 @@ def test_target_names_pair_up():
     assert convert.target_name("d/x.launch.xml.yaml", "xml") == "d/x.launch.xml"
     assert convert.target_name("d/x.launch.yaml", "xml") == "d/x.launch"
     assert convert.target_name("d/x.yml", "xml") == "d/x.launch"
+
+
+def test_empty_attribute_is_written_as_an_empty_string_not_a_tagged_null():
+    entity = Entity("launch", children=[Entity("arg", {"name": "x", "default": ""})])
+    text = convert.to_yaml(entity)
+    assert "default: ''" in text and "!!null" not in text
+    assert yaml_frontend.parse_string(text, "x.yaml").children[0].get("default") == ""

@@ -234,3 +234,21 @@ def test_python_node_package_launches_at_once_and_stops_cleanly(tmp_path):
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)
             proc.wait()
+
+
+def test_package_made_in_ws_src_is_found_from_the_workspace_root(tmp_path):
+    src = tmp_path / "ws" / "src"
+    src.mkdir(parents=True)
+    assert orchestra_make(["mine", "rospy"], src).returncode == 0
+    env = {k: v for k, v in ENV.items() if k not in ("ROS_PACKAGE_PATH", "CMAKE_PREFIX_PATH")}
+    env["ROS_HOME"] = str(tmp_path / "home")
+    for where in (tmp_path / "ws", src):
+        found = subprocess.run([*ORCHESTRA, "pkg", "find", "mine"], cwd=where, env=env,
+                               capture_output=True, text=True, timeout=60)
+        assert found.returncode == 0, (where, found.stderr)
+        assert found.stdout.strip() == str(src / "mine")
+    # a src/ without packages does not make its parent a workspace
+    (tmp_path / "other" / "src").mkdir(parents=True)
+    missing = subprocess.run([*ORCHESTRA, "pkg", "find", "mine"], cwd=tmp_path / "other",
+                             env=env, capture_output=True, text=True, timeout=60)
+    assert missing.returncode == 2

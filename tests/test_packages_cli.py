@@ -272,3 +272,17 @@ def test_pkg_roots_and_which_show_search_path_and_resolved_executable(env, tmp_p
     assert roots[0] == f"{env} [ROS_PACKAGE_PATH]"
     assert roots[-1].endswith("[bundled]")
     assert cli("pkg", "which", "whiched", "thing", cwd=tmp_path).stdout.strip() == str(exe)
+
+
+def test_misspelled_package_and_launch_file_get_a_did_you_mean():
+    import subprocess
+    import sys
+
+    def launch(*words: str) -> subprocess.CompletedProcess:
+        return subprocess.run([sys.executable, "-m", "orchestra", "launch", *words, "--nodes"],
+                              capture_output=True, text=True, timeout=60)
+
+    pkg = launch("learnin_tf", "start_tf_demo.launch")
+    assert pkg.returncode == 2 and pkg.stderr.rstrip().endswith("(did you mean learning_tf?)")
+    file = launch("learning_tf", "start_tf_dem.launch")
+    assert file.returncode == 2 and "(did you mean start_tf_demo.launch" in file.stderr

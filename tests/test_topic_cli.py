@@ -164,6 +164,41 @@ def test_topic_hz_reports_the_average_rate(nodes):
     assert "\tmin: " in result.stdout and "window: " in result.stdout
 
 
+def test_topic_hz_piped_prints_its_reports_and_ends_quietly_on_ctrl_c(nodes):
+    import signal
+
+    nodes.start("pub.py", "fast", "std_msgs/Empty", "{}", "--rate", "50").ready()
+    hz = subprocess.Popen([sys.executable, "-m", "orchestra", "topic", "hz", "/fast"],
+                          env=nodes.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                          text=True)
+    try:       # a report read through the pipe while it runs: nothing held back
+        assert hz.stdout.readline() == "subscribed to [/fast]\n"
+        assert hz.stdout.readline().startswith("average rate: ")
+    finally:
+        hz.send_signal(signal.SIGINT)
+        _, err = hz.communicate(timeout=30)
+    assert hz.returncode == 0 and err == ""
+
+
+def test_ctrl_c_while_a_command_waits_for_the_master_is_quiet(nodes):
+    import signal
+    import socket
+
+    with socket.socket() as silent:      # accepts connections, never answers
+        silent.bind(("127.0.0.1", 0))
+        silent.listen(4)
+        env = dict(nodes.env, ROS_MASTER_URI=f"http://127.0.0.1:{silent.getsockname()[1]}/")
+        hz = subprocess.Popen([sys.executable, "-m", "orchestra", "topic", "hz", "/fast"],
+                              env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                              text=True)
+        conn, _ = silent.accept()        # hz is now inside the command, asking the master
+        hz.send_signal(signal.SIGINT)
+        _, err = hz.communicate(timeout=30)
+        conn.close()
+    assert hz.returncode == 130
+    assert "Aborted" not in err and "Traceback" not in err
+
+
 def test_service_list_type_info_and_call(nodes):
     nodes.start("adder.py", "add").ready()
     # with the logger services every node offers (tests/test_node_loggers.py)

@@ -152,6 +152,21 @@ def test_gui_requested_on_an_unusable_display_falls_back_to_headless(master):
     assert "Traceback" not in output
 
 
+@pytest.mark.timeout(60)
+def test_headless_simulator_says_so_and_how_to_get_a_picture(master):
+    env = {k: v for k, v in BUNDLED_ENV.items() if k != "DISPLAY"}
+    env.update(ROS_MASTER_URI=master, PYTHONUNBUFFERED="1")
+    sim = subprocess.Popen([str(SIM)], env=env, stdout=subprocess.PIPE,
+                           stderr=subprocess.STDOUT, text=True)
+    try:
+        reader = subprocess.run([sys.executable, "-c", READ_POSE], env=env, capture_output=True,
+                                text=True, timeout=40)
+        assert reader.returncode == 0, reader.stderr
+    finally:
+        output = _interrupt(sim)
+    assert "runs headless" in output and "snapshot:=" in output
+
+
 @contextlib.contextmanager
 def _virtual_screen():
     """Start Xvfb on a display it picks itself and yield ":N" once it accepts clients.

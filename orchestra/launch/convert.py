@@ -114,7 +114,8 @@ def _body_node(entity: Entity):
             return _scalar("")  # `- group:` : nothing in it
         return _children_node(entity.children)
     pairs: list[tuple[Node, Node]] = [
-        (_scalar(name), _scalar(value)) for name, value in entity.attributes.items()]
+        (_scalar(name), _scalar(value, "'" if value == "" else None))  # '' not !!null ''
+        for name, value in entity.attributes.items()]
     if text is not None:
         style = "|" if "\n" in text else None
         pairs.append((_scalar(yaml_frontend.TEXT_KEY), _scalar(text, style)))

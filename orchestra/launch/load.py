@@ -27,8 +27,12 @@ def find_in_package(package: str, filename: str) -> str:
         if base in files:
             matches.append(os.path.join(dirpath, base))
     if not matches:
+        from orchestra.suggest import did_you_mean
+
+        launch_files = [f for _, _, files in os.walk(root, followlinks=True) for f in files
+                        if f.endswith((".launch", ".xml", ".yaml")) and f != "package.xml"]
         raise OrchestraError(f"[{filename}] is neither a launch file in package [{package}] "
-                             "nor a launch file name")
+                             f"nor a launch file name{did_you_mean(base, launch_files)}")
     if len(matches) > 1:
         listing = "".join(f"\n  {m}" for m in matches)
         raise OrchestraError(f"multiple files named [{filename}] in package [{package}]:"

@@ -218,7 +218,8 @@ def _control(op: str, names: tuple[str, ...], force: bool = False, sig: str = ""
     Names the launch does not know but the master does (nodes started by something else)
     are stopped the way ``node kill`` does; anything else is unknown: exit 2, nothing done.
     """
-    from orchestra.supervise.control import did_you_mean, matches
+    from orchestra.suggest import did_you_mean
+    from orchestra.supervise.control import matches
     from orchestra.supervise.status import request
 
     uri = _master_uri()

@@ -61,9 +61,10 @@ def catkin_workspace(cwd: str) -> str | None:
     The nearest ancestor whose ``src/`` sits next to a workspace marker wins; without any
     marker (a workspace made by hand, no ROS installed), standing inside a directory named
     ``src`` makes its parent the workspace, so ``mkdir -p ws/src && cd ws/src &&
-    orchestra create-pkg demo`` is usable at once. A ``src/`` that is merely *below* an
-    ancestor is not enough: ``~/src`` is common and crawling it from anywhere in the home
-    directory would be slow and surprising.
+    orchestra create-pkg demo`` is usable at once; so does standing in ``ws`` itself when
+    ``ws/src`` holds a package (``ws/src/demo/package.xml``), the usual place to run from. A
+    ``src/`` that is merely *below* an ancestor is not enough: ``~/src`` is common and
+    crawling it from anywhere in the home directory would be slow and surprising.
     """
     start = _normal(cwd)
     directory = start
@@ -73,12 +74,27 @@ def catkin_workspace(cwd: str) -> str | None:
             for marker in WORKSPACE_MARKERS:
                 if os.path.exists(os.path.join(directory, marker)):
                     return directory
+            if directory == start and _holds_package(os.path.join(directory, "src")):
+                fallback = directory
         parent = os.path.dirname(directory)
         if fallback is None and os.path.basename(directory) == "src" and parent != directory:
             fallback = parent
         if parent == directory:
             return fallback
         directory = parent
+
+
+def _holds_package(src: str) -> bool:
+    """``src/package.xml`` or ``src/<pkg>/package.xml`` exists (one level, no crawl)."""
+    if os.path.isfile(os.path.join(src, "package.xml")):
+        return True
+    try:
+        entries = os.scandir(src)
+    except OSError:
+        return False
+    with entries:
+        return any(entry.is_dir() and os.path.isfile(os.path.join(entry.path, "package.xml"))
+                   for entry in entries)
 
 
 def _catkin_source_spaces(prefix: str) -> list[str]:

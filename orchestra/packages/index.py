@@ -25,6 +25,7 @@ from orchestra.packages.discovery import (
     search_path,
     search_roots,
 )
+from orchestra.suggest import did_you_mean
 
 log = logging.getLogger(__name__)
 
@@ -37,7 +38,7 @@ _USE_DEFAULT = object()
 class PackageNotFound(OrchestraError):
     """A package name that no directory on the search path answers to."""
 
-    def __init__(self, name: str, metapackage_dir: str | None = None):
+    def __init__(self, name: str, metapackage_dir: str | None = None, hint: str = ""):
         if metapackage_dir is not None:
             message = (f"package '{name}' not found: {metapackage_dir} is a metapackage, and "
                        "like rospack (and so roslaunch's $(find)) orchestra does not resolve "
@@ -45,7 +46,7 @@ class PackageNotFound(OrchestraError):
         else:
             message = (f"package '{name}' not found (searched ROS_PACKAGE_PATH, "
                        "CMAKE_PREFIX_PATH, the current catkin workspace and orchestra's "
-                       "bundled packages)")
+                       f"bundled packages){hint}")
         super().__init__(message)
         self.name = name
 
@@ -94,7 +95,8 @@ class PackageIndex:
         try:
             return self.packages[name]
         except KeyError:
-            raise PackageNotFound(name, self.metapackages.get(name)) from None
+            raise PackageNotFound(name, self.metapackages.get(name),
+                                  did_you_mean(name, self.packages)) from None
 
     def __contains__(self, name: str) -> bool:
         return name in self.packages

@@ -16,12 +16,11 @@ a consistent state and never race with an exit being handled.
 """
 from __future__ import annotations
 
-import difflib
 import fnmatch
 import signal
-from collections.abc import Iterable
 from typing import Any
 
+from orchestra.suggest import did_you_mean
 from orchestra.supervise.supervisor import ControlError, Supervisor
 
 OPS = ("stop", "start", "restart", "signal", "mute", "unmute")
@@ -33,17 +32,6 @@ class UnknownProcess(ControlError):
     def __init__(self, message: str, unknown: list[str]):
         super().__init__(message)
         self.unknown = unknown
-
-
-def did_you_mean(word: str, choices: Iterable[str]) -> str:
-    """`` (did you mean /a, /b?)`` for close matches of ``word``, or ``""``."""
-    choices = list(choices)
-    close = difflib.get_close_matches(word, choices, n=3, cutoff=0.6)
-    if not close:
-        bare = {c.rsplit("/", 1)[-1]: c for c in choices}
-        close = [bare[m] for m in difflib.get_close_matches(word.rsplit("/", 1)[-1], bare,
-                                                            n=3, cutoff=0.6)]
-    return f" (did you mean {', '.join(close)}?)" if close else ""
 
 
 def matches(pattern: str, names: list[str]) -> list[str]:
