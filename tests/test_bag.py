@@ -467,3 +467,32 @@ def test_play_on_a_terminal_pauses_with_space_and_steps_with_s(master, tmp_path)
         os.close(keys)
         os.close(tty)
 
+
+
+def test_record_onto_a_full_disk_stops_with_one_line_and_a_valid_bag(master, tmp_path):
+    mnt = tmp_path / "small"
+    mnt.mkdir()
+    if os.geteuid() != 0 or subprocess.run(["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs",
+                                            str(mnt)], capture_output=True).returncode != 0:
+        pytest.skip("cannot mount a small tmpfs here (needs root)")
+    env = _env(master)
+    rec = pub = None
+    try:
+        rec = _start([sys.executable, "-m", "orchestra", "bag", "record", "-q", "-O",
+                      str(mnt / "x"), "--chunksize", "8", "/numbers"], env)
+        wait_for(lambda: _subscribed(master.uri, "/numbers"), timeout=20)
+        pub = _start([sys.executable, str(FIXTURES / "burst.py"), "/numbers", "20000",
+                      "5000"], env)
+        assert rec.wait(timeout=60) == 2
+        wait_for(lambda: rec.stderr_lines, timeout=5)
+        assert len(rec.stderr_lines) == 1 and "No space left on device" in \
+            rec.stderr_lines[0] and "messages written before" in rec.stderr_lines[0], \
+            rec.stderr_lines
+        with BagReader(str(mnt / "x.bag")) as r:
+            got = [d for _, _, d in r.messages()]
+        assert len(got) > 100 and got == [_string(f"n {i}") for i in range(len(got))]
+    finally:
+        for proc in (rec, pub):
+            if proc is not None:
+                proc.kill()
+        subprocess.run(["umount", str(mnt)], capture_output=True)

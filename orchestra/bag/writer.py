@@ -13,6 +13,7 @@ cannot recover from a failed write. Recording needs all three, so this writer:
 """
 from __future__ import annotations
 
+import errno
 import logging
 import os
 from dataclasses import dataclass, field
@@ -181,21 +182,29 @@ class BagWriter:
     # --- internals --------------------------------------------------------------------------
 
     def _write_index(self) -> None:
+        """Write the index after the last good chunk. When even that does not fit (a disk
+        filled to the last page), give up the newest chunks one by one until it does: a
+        valid bag with fewer messages beats an unindexed one."""
         assert self._fd is not None
-        kept = [c for c in self.connections if c.id in self._in_file]
-        index = b"".join([c.encode() for c in kept] + [i.encode() for i in self._infos])
-        header = encode_bag_header(self._good_end, len(kept), len(self._infos))
-        try:
-            os.ftruncate(self._fd, self._good_end)
-            os.lseek(self._fd, self._good_end, os.SEEK_SET)
-            self._write(index)
-            os.lseek(self._fd, len(MAGIC), os.SEEK_SET)
-            self._write(header)
-        except OSError as exc:
-            if self.failed is None:
-                self.failed = exc
-            log.error("%s: cannot write the index (%s); `orchestra bag reindex` repairs it",
-                      self.path, exc)
+        while True:
+            used = {cid for info in self._infos for cid in info.counts}
+            kept = [c for c in self.connections if c.id in used]
+            index = b"".join([c.encode() for c in kept] + [i.encode() for i in self._infos])
+            try:
+                os.ftruncate(self._fd, self._good_end)
+                os.lseek(self._fd, self._good_end, os.SEEK_SET)
+                self._write(index)
+                os.lseek(self._fd, len(MAGIC), os.SEEK_SET)
+                self._write(encode_bag_header(self._good_end, len(kept), len(self._infos)))
+                return
+            except OSError as exc:
+                if self.failed is None:
+                    self.failed = exc
+                if exc.errno not in (errno.ENOSPC, errno.EDQUOT) or not self._infos:
+                    log.error("%s: cannot write the index (%s); `orchestra bag reindex` "
+                              "repairs it", self.path, exc)
+                    return
+                self._good_end = self._infos.pop().pos
 
     def _write(self, blob: bytes) -> None:
         assert self._fd is not None
