@@ -220,3 +220,12 @@ def test_agent_reap_kills_what_is_left_of_the_run(package):
                          capture_output=True, text=True, timeout=30)
     assert json.loads(out.stdout)["killed"] == [left.pid]
     assert left.wait(timeout=5) == -signal.SIGKILL
+
+
+def test_an_external_loopback_master_is_a_warning_for_remote_nodes():
+    from orchestra.app.machines import master_warnings
+
+    assert master_warnings("http://localhost:11311/", embedded=True) == []
+    assert master_warnings("http://base.local:11311/", embedded=False) == []
+    (warning,) = master_warnings("http://127.0.0.1:11311/", embedded=False)
+    assert "external" in warning and "ROS_MASTER_URI" in warning

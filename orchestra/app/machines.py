@@ -6,6 +6,7 @@ out. Every machine is connected and checked before anything starts (all-or-nothi
 """
 from __future__ import annotations
 
+import urllib.parse
 from collections.abc import Sequence
 from dataclasses import replace
 from typing import Any
@@ -47,6 +48,18 @@ def open_remote(plan: LaunchPlan, remote: list[Node], watchdog: Watchdog) -> Rem
                             watch=watchdog.watch)
     session.open()
     return session
+
+
+def master_warnings(master_uri: str, embedded: bool) -> list[str]:
+    """A master other machines probably cannot reach: an external one on a loopback URI
+    (ours listens on every interface when the plan has remote nodes)."""
+    host = urllib.parse.urlsplit(master_uri).hostname or "localhost"
+    if embedded or not (host in ("localhost", "::1") or host.startswith("127.")):
+        return []
+    return [f"orchestra: warning: the master at {master_uri} is external and named by a "
+            "loopback address; remote nodes are told to use this host's address instead, "
+            "which works only if that master listens on it (set ROS_MASTER_URI to a name "
+            "the other machines can reach)"]
 
 
 def remote_specs(session: Any, remote: list[Node], master_uri: str, run_id: str,

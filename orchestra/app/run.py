@@ -25,7 +25,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
 
-from orchestra.app.machines import open_remote, remote_specs, split_remote
+from orchestra.app.machines import master_warnings, open_remote, remote_specs, split_remote
 from orchestra.app.master import (
     MasterConnection,
     check_param_actions,
@@ -345,6 +345,8 @@ class LaunchRun:
             if session is not None:
                 specs += remote_specs(session, remote, master.uri, master.run_id,
                                       self.log_dir, opts)
+                for warning in master_warnings(master.uri, master.embedded):
+                    self._report(warning)
             screen = self._screen or Screen()
             if not opts.disable_title and plan.files_loaded:
                 _set_title(" ".join(plan.files_loaded[:1]) + f" {master.uri}")
