@@ -38,7 +38,13 @@ def unavailable() -> str | None:
     probe = subprocess.run(["ip", "netns", "add", name], capture_output=True, text=True)
     if probe.returncode != 0:
         return f"cannot create a network namespace: {probe.stderr.strip()}"
-    subprocess.run(["ip", "netns", "del", name], capture_output=True)
+    try:
+        inside = subprocess.run(["ip", "netns", "exec", name, "true"], capture_output=True,
+                                text=True)
+    finally:
+        subprocess.run(["ip", "netns", "del", name], capture_output=True)
+    if inside.returncode != 0:
+        return f"cannot run a program in a network namespace: {inside.stderr.strip()}"
     return None
 
 
