@@ -197,8 +197,12 @@ class RemoteSession:
             data = {"machine": name, "address": entry.machine.address, "mark": self.mark,
                     "nodes": nodes, "socket": entry.remote_socket}
             command = agent_command(entry.machine, "http://localhost:11311/", "serve", data)
-            entry.agent = self._spawn(ssh.session_argv(entry.target, command, self.program),
-                                      stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+            # stderr to a file: nobody reads the agent's pipes during the run, and a full
+            # pipe would block it
+            with open(entry.target.control_path + ".agent.err", "wb") as err:
+                entry.agent = self._spawn(
+                    ssh.session_argv(entry.target, command, self.program),
+                    stdout=subprocess.PIPE, stderr=err)
         problems = [problem for problem in (self._agent_ready(entry)
                                             for entry in self.machines.values()) if problem]
         if problems:
@@ -231,8 +235,9 @@ class RemoteSession:
                 return None
         if agent.poll() is None:
             agent.kill()
-        _, err = agent.communicate()
-        return self._agent_failure(entry, agent.returncode, err.decode(errors="replace"))
+        agent.communicate()
+        return self._agent_failure(entry, agent.returncode,
+                                   _read(entry.target.control_path + ".agent.err"))
 
     def _agent_failure(self, entry: _Machine, code: int | None, err: str) -> RemoteError:
         loader = entry.machine.env_loader
