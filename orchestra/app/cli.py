@@ -52,6 +52,10 @@ _OPTIONS = [
                  help="Rotated log files kept per stream."),
     click.option("--status/--no-status", "status_view", default=None,
                  help="Live status table under the output (default: on a terminal)."),
+    click.option("--ui/--no-ui", "ui", default=None,
+                 help="--ui: the interactive view (select a node, s stop/start, r restart, "
+                      "m mute, l log, / filter, q quit); it takes the keyboard from the nodes. "
+                      "--no-ui: plain output, no live table."),
     click.option("--with-tests", is_flag=True, help="Also run the <test> nodes (test mode)."),
     click.option("--pid", "pid_file", default=None, metavar="FILE",
                  help="Write orchestra's pid to FILE (removed when the launch ends)."),
@@ -87,6 +91,8 @@ def options_from_cli(kwargs: dict[str, Any]) -> Any:
         raise OrchestraError("--screen and --log cannot be used together")
     if "log_max_size" in values:
         values["log_max_bytes"] = parse_size(values.pop("log_max_size"))
+    if values.get("ui") is False:
+        values["status_view"] = False
     return RunOptions.from_kwargs(values)
 
 

@@ -34,6 +34,7 @@ class RunOptions(SpecOptions):
     log_max_bytes: int = 0
     log_backups: int = 5
     status_view: bool | None = None
+    ui: bool = False
     with_tests: bool = False
     no_rosout: bool = False
     master_uri: str | None = None

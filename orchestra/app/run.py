@@ -41,6 +41,7 @@ from orchestra.launch.plan import LaunchPlan, Node
 from orchestra.remote.session import RemoteSession
 from orchestra.rpc import TRANSPORT_ERRORS, proxy
 from orchestra.supervise import control
+from orchestra.supervise.interactive import InteractiveView, terminal_ok
 from orchestra.supervise.output import Screen, prepare_run_log_dir
 from orchestra.supervise.process import ManagedProcess, State
 from orchestra.supervise.reaper import Watchdog
@@ -396,7 +397,13 @@ class LaunchRun:
             self._closers.append(lambda: delete_param(master.uri, uris_key))
         opts = self.options
         view_on = opts.status_view if opts.status_view is not None else screen.out.isatty()
-        if view_on:
+        if opts.ui and terminal_ok(sys.stdin, screen.out):
+            ui = InteractiveView(supervisor.loop, supervisor, screen, make_snapshot,
+                                 sys.stdin.fileno())
+            supervisor.on_change = ui.changed
+            supervisor.loop.call_later(0, ui.start)
+            self._closers.append(ui.close)
+        elif view_on:
             view = LiveView(supervisor.loop, screen, make_snapshot)
             supervisor.on_change = view.changed
             supervisor.loop.call_later(0, view.start)
