@@ -26,6 +26,7 @@ COMMANDS: dict[str, str] = {
     "core": "orchestra.app.cli:core",
     "param": "orchestra.params.cli:param",
     "status": "orchestra.app.cli:status",
+    "logs": "orchestra.app.logs:logs",
     "test": "orchestra.app.cli:test_command",
     "node": "orchestra.node.cli:node",
     "topic": "orchestra.node.cli:topic",
