@@ -322,9 +322,11 @@ def play(files: tuple[str, ...], rate: float, start: float, duration: float | No
     stop = _stop_on_signals(player.stopped)
     worker = threading.Thread(target=player.run, name="bag-play", daemon=True)
     try:
-        player.advertise()
-        worker.start()
+        # the terminal is in cbreak mode before anything is advertised: a key pressed as
+        # soon as a subscriber is connected is not lost
         with _keyboard(player) as keys:
+            player.advertise()
+            worker.start()
             while worker.is_alive():
                 keys()
                 if not quiet and sys.stdout.isatty():
@@ -332,7 +334,8 @@ def play(files: tuple[str, ...], rate: float, start: float, duration: float | No
                 worker.join(0.05)
     finally:
         player.stop()
-        worker.join(2.0)
+        if worker.ident is not None:
+            worker.join(2.0)
         stop()
         player.close()
         if not quiet and sys.stdout.isatty():
@@ -374,7 +377,7 @@ def _keyboard(player):
     import tty
     fd = sys.stdin.fileno()
     saved = termios.tcgetattr(fd)
-    tty.setcbreak(fd)
+    tty.setcbreak(fd, termios.TCSANOW)  # keep keys already typed
 
     def poll() -> None:
         while select.select([fd], [], [], 0)[0]:
