@@ -7,62 +7,88 @@ is part of the product. Each area owns its own ``cli`` module; this file only li
 from __future__ import annotations
 
 import importlib
-import logging
 import sys
 
 import click
 
 from orchestra.errors import OrchestraError
 
-# name -> "module:attribute" of a click command or group
-COMMANDS: dict[str, str] = {
-    "launch": "orchestra.app.cli:launch",
-    "check": "orchestra.launch.tools_cli:check",
-    "convert": "orchestra.launch.tools_cli:convert",
-    "export": "orchestra.export.cli:export",
-    "pkg": "orchestra.packages.cli:pkg",
-    "run": "orchestra.packages.cli:run",
-    "create-pkg": "orchestra.packages.cli:create_pkg",
-    "core": "orchestra.app.cli:core",
-    "param": "orchestra.params.cli:param",
-    "status": "orchestra.app.cli:status",
-    "logs": "orchestra.app.logs:logs",
-    "test": "orchestra.app.cli:test_command",
-    "node": "orchestra.node.cli:node",
-    "topic": "orchestra.node.cli:topic",
-    "service": "orchestra.node.cli:service",
-    "graph": "orchestra.node.cli:graph",
-    "bag": "orchestra.bag.cli:bag",
-    "plot": "orchestra.plot.cli:plot",
-    "env": "orchestra.ros1.cli:env",
-    "msg": "orchestra.node.msgcli:msg",
-    "srv": "orchestra.node.msgcli:srv",
+# name -> ("module:attribute" of a click command or group, its one-line help). The help is
+# here so that ``orchestra --help`` lists the commands without importing any of them
+# (tests/test_cli.py checks it against each command's own docstring).
+COMMANDS: dict[str, tuple[str, str]] = {
+    "launch": ("orchestra.app.cli:launch",
+               "Resolve and run a roslaunch file: orchestra launch [PKG] FILE [name:=value ...]."),
+    "check": ("orchestra.launch.tools_cli:check",
+              "Report every problem in launch files (and what they include), starting nothing."),
+    "convert": ("orchestra.launch.tools_cli:convert",
+                "Convert a launch file (or every launch file under a directory) between XML and "
+                "YAML."),
+    "export": ("orchestra.export.cli:export",
+               "Write a launch file as units for another process manager (see docs/remote.md)."),
+    "pkg": ("orchestra.packages.cli:pkg", "Find packages and their dependencies (like rospack)."),
+    "run": ("orchestra.packages.cli:run", "Run executable EXE of PACKAGE with ARGS (like rosrun)."),
+    "create-pkg": ("orchestra.packages.cli:create_pkg",
+                   "Create catkin package NAME depending on DEPS (like catkin_create_pkg)."),
+    "core": ("orchestra.app.cli:core",
+             "Run a ROS master, parameter server and the rosout node until interrupted."),
+    "param": ("orchestra.params.cli:param",
+              "Get, set, list, delete, load and dump parameters (rosparam compatible)."),
+    "status": ("orchestra.app.cli:status",
+               "Show the nodes of the running launch: state, pid, restarts, uptime, CPU%, RSS, "
+               "and why a node is not running."),
+    "logs": ("orchestra.app.logs:logs",
+             "Without NODE: the log directory of the run at ROS_MASTER_URI (roslaunch-logs)."),
+    "test": ("orchestra.app.cli:test_command",
+             "Run a launch file's <test>s as rostest does: orchestra test [PKG] FILE "
+             "[name:=value ...]."),
+    "node": ("orchestra.node.cli:node",
+             "Running nodes: list, info, kill, ping, cleanup (like rosnode); loggers and "
+             "set-logger-level (like rosconsole list/get/set)."),
+    "topic": ("orchestra.node.cli:topic",
+              "Topics: list, find, info, type, echo, pub, hz (like rostopic)."),
+    "service": ("orchestra.node.cli:service",
+                "Services: list, info, type, uri, args, call (like rosservice)."),
+    "graph": ("orchestra.node.cli:graph", "Draw the running nodes and the topics between them."),
+    "bag": ("orchestra.bag.cli:bag", "Record, play and inspect ROS 1 bags (rosbag)."),
+    "plot": ("orchestra.plot.cli:plot",
+             "Plot numeric fields: TOPIC/FIELD, several fields as TOPIC/F1:F2 (as rqt_plot)."),
+    "env": ("orchestra.ros1.cli:env",
+            "Print shell lines that give Python processes orchestra's ROS 1 layer."),
+    "msg": ("orchestra.node.msgcli:msg",
+            "Message types (like rosmsg): show, md5, list, package, packages."),
+    "srv": ("orchestra.node.msgcli:srv",
+            "Service types (like rossrv): show, md5, list, package, packages."),
 }
 
 
 class LazyGroup(click.Group):
-    """A click group that imports a sub-command's module only when that command is used."""
+    """A click group that imports a sub-command's module only when that command is used;
+    its help lists the commands from the table, importing none of them."""
 
     def list_commands(self, ctx: click.Context) -> list[str]:
-        return sorted(name for name in COMMANDS if self._load(name) is not None)
+        return sorted(COMMANDS)
 
     def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
         return self._load(cmd_name)
 
+    def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        names = self.list_commands(ctx)
+        limit = formatter.width - 6 - max(len(name) for name in names)
+        rows = [(name, click.utils.make_default_short_help(COMMANDS[name][1], limit))
+                for name in names]
+        with formatter.section("Commands"):
+            formatter.write_dl(rows)
+
     @staticmethod
     def _load(name: str) -> click.Command | None:
-        target = COMMANDS.get(name)
-        if target is None:
+        entry = COMMANDS.get(name)
+        if entry is None:
             return None
-        module_name, attr = target.split(":")
-        try:
-            module = importlib.import_module(module_name)
-        except ModuleNotFoundError as exc:
-            # an area not built yet: its commands are simply not offered
-            if exc.name and module_name.startswith(exc.name):
-                return None
-            raise
-        return getattr(module, attr, None)
+        module_name, attr = entry[0].split(":")
+        command = getattr(importlib.import_module(module_name), attr)
+        assert isinstance(command, click.Command)
+        return command
 
 
 @click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
@@ -70,6 +96,8 @@ class LazyGroup(click.Group):
 @click.option("-v", "--verbose", count=True, help="More log output (-vv for debug).")
 def cli(verbose: int) -> None:
     """roslaunch-compatible launch orchestration: same launch files, no ROS install."""
+    import logging  # here, not at import time: ``orchestra --help`` does not need it
+
     level = logging.WARNING - 10 * min(verbose, 2)
     logging.basicConfig(level=level, format="[%(levelname)s] %(name)s: %(message)s")
 

@@ -18,3 +18,25 @@ def test_unknown_command_is_an_error_without_traceback():
     proc = run("no-such-command")
     assert proc.returncode != 0
     assert "Traceback" not in proc.stderr
+
+
+def test_command_table_help_is_each_commands_own_help():
+    """``orchestra --help`` lists the table's help lines without importing the commands, so
+    each line must be the command's own first docstring sentence (click's short help)."""
+    from orchestra.cli import COMMANDS, LazyGroup
+
+    for name, (_, help_line) in COMMANDS.items():
+        command = LazyGroup._load(name)
+        assert command is not None
+        assert command.get_short_help_str(limit=10_000) == help_line, name
+
+
+def test_help_imports_no_sub_command():
+    code = ("import sys; from orchestra.cli import main\n"
+            "try:\n    main(['--help'])\nexcept SystemExit:\n    pass\n"
+            "loaded = sorted(m for m in sys.modules if m.startswith('orchestra.')"
+            " and m not in ('orchestra.cli', 'orchestra.errors'))\n"
+            "print(loaded, 'logging' in sys.modules, 'yaml' in sys.modules)")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=60)
+    assert proc.stdout.strip().endswith("[] False False"), proc.stdout + proc.stderr

@@ -2,8 +2,12 @@
 import math
 
 import pytest
+import yaml
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from orchestra.errors import OrchestraError
+from orchestra.params.dump import LaunchParamsDumper, _c_emits_the_same, dump_launch_params
 from orchestra.params.yaml import flatten, load_rosparam_yaml
 
 
@@ -70,3 +74,28 @@ def test_hostile_values_are_refused_at_their_position(text, position, why):
     if position is not None:
         assert location.line == position[0]
         assert position[1] is None or location.column == position[1]
+
+
+_TEXT = st.text(alphabet=st.sampled_from(list("ab :#-'\"\\{}[],&*!|>%@`?=~.09eE+\n\t\x85é")),
+                max_size=150)
+_VALUES = st.recursive(
+    st.none() | st.booleans() | st.integers() | st.floats() | _TEXT | st.binary(max_size=300),
+    lambda inner: st.lists(inner, max_size=4) | st.dictionaries(_TEXT, inner, max_size=4),
+    max_leaves=12)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.dictionaries(_TEXT | st.text(alphabet="a/", min_size=118, max_size=134), _VALUES,
+                       max_size=5))
+def test_dump_params_is_pyyamls_safe_dump_byte_for_byte(params):
+    """--dump-params takes libyaml's emitter only where it writes PyYAML's bytes."""
+    assert dump_launch_params(params) == yaml.dump(params, Dumper=LaunchParamsDumper,
+                                                   default_flow_style=False)
+
+
+def test_dump_params_takes_the_c_emitter_for_plain_text_and_numbers():
+    assert _c_emits_the_same({"a": {"b": ["x y", 1, 2.5, None, True, b"\x00"]}})
+    assert not _c_emits_the_same({"a": "two\nlines"})
+    assert not _c_emits_the_same({"": 1})
+    assert not _c_emits_the_same({"k" * 125: 1})
+    assert _c_emits_the_same({"k" * 200: 1})

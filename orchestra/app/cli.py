@@ -258,13 +258,11 @@ def launch(ctx: click.Context, words: tuple[str, ...], dump_plan: bool, dump_par
     if dump_plan:
         click.echo(_dump_json(plan))
     elif dump_params:
-        import yaml
+        from orchestra.params.dump import dump_launch_params
 
-        from orchestra.launch.interpreter import Binary
-        yaml.SafeDumper.add_representer(Binary, yaml.SafeDumper.represent_binary)
         # roslaunch prints the YAML document (which ends in a newline) with print(), so its
         # output ends in an empty line; scripts diff the two, so match it byte for byte
-        click.echo(yaml.safe_dump(dict(plan.params), default_flow_style=False))
+        click.echo(dump_launch_params(dict(plan.params)))
     elif nodes:
         names = [n.full_name for n in (*plan.nodes, *plan.tests) if n.name]
         if names:

@@ -425,14 +425,15 @@ class Interpreter:
 
     def _convert(self, entity: Entity, text: str, ptype: str, source: str) -> Any:
         """``text`` typed by ``ptype``; a bad value or bad YAML is an error at the tag."""
-        from orchestra.params.yaml import RosparamYamlError
         try:
             if ptype == "yaml":
-                from orchestra.params.yaml import load_yaml_value
-                return load_yaml_value(text, entity.location.file)
+                # the YAML loader is imported for type="yaml" only (the CLI's start-up time)
+                from orchestra.params.yaml import RosparamYamlError, load_yaml_value
+                try:
+                    return load_yaml_value(text, entity.location.file)
+                except RosparamYamlError as exc:
+                    raise self._error(entity, exc.message, source) from None
             return convert_value(text, ptype)
-        except RosparamYamlError as exc:
-            raise self._error(entity, exc.message, source) from None
         except ValueError as exc:
             raise self._error(entity, str(exc), "type" if ptype != "auto" else source) from None
 
