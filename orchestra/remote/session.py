@@ -129,12 +129,13 @@ class RemoteSession:
         self.watch = watch
         self.nodes = list(nodes)
         self.program = ssh.ssh_program()
+        for node in self.nodes:                  # refused before anything is created
+            check_machine_config(machines[node.machine_name or ""], node)
         self.dir = tempfile.mkdtemp(prefix="orchestra-ssh-")
         self.machines: dict[str, _Machine] = {}
         token = secrets.token_hex(8)
         for node in self.nodes:
             machine = machines[node.machine_name or ""]
-            check_machine_config(machine, node)
             if machine.name not in self.machines:
                 number = len(self.machines)
                 self.machines[machine.name] = _Machine(
