@@ -39,6 +39,8 @@ COMMANDS: dict[str, tuple[str, str]] = {
                "and why a node is not running."),
     "logs": ("orchestra.app.logs:logs",
              "Without NODE: the log directory of the run at ROS_MASTER_URI (roslaunch-logs)."),
+    "completion": ("orchestra.completion:completion",
+                   "Print the shell completion script for SHELL (bash, zsh or fish)."),
     "test": ("orchestra.app.cli:test_command",
              "Run a launch file's <test>s as rostest does: orchestra test [PKG] FILE "
              "[name:=value ...]."),

@@ -142,3 +142,11 @@ def test_status_shows_only_the_launch_at_ros_master_uri(env, launch):
     assert len(heads(both.stdout)) == 2
     nobody = orchestra(dict(env, ROS_MASTER_URI=f"http://localhost:{free_port()}/"), "status")
     assert nobody.returncode == 1 and "orchestra status --all" in nobody.stderr
+
+
+def test_node_names_of_the_running_launch_complete(env, launch):
+    environ = dict(env, _ORCHESTRA_COMPLETE="bash_complete",
+                   COMP_WORDS="orchestra node restart /g", COMP_CWORD="3")
+    out = subprocess.run([sys.executable, "-m", "orchestra"], env=environ,
+                         capture_output=True, text=True, timeout=60).stdout
+    assert out.splitlines() == ["plain,/g/c"]

@@ -17,6 +17,7 @@ from typing import Any
 
 import click
 
+from orchestra.completion import complete_launch_words
 from orchestra.errors import OrchestraError
 
 _OPTIONS = [
@@ -216,7 +217,7 @@ def launch_words(words: tuple[str, ...], command: str) -> tuple[list[str], dict[
 
 
 @click.command(context_settings={"help_option_names": ["-h", "--help"]})
-@click.argument("words", nargs=-1)
+@click.argument("words", nargs=-1, shell_complete=complete_launch_words)
 @click.option("--dump-plan", is_flag=True, help="Print the resolved plan as JSON and exit.")
 @click.option("--dump-params", is_flag=True, help="Print the parameters as YAML and exit.")
 @click.option("--nodes", is_flag=True, help="List the nodes' full names and exit.")

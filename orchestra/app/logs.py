@@ -12,9 +12,11 @@ import os
 import re
 import time
 from collections.abc import Iterator
+from typing import Any
 
 import click
 
+from orchestra.completion import complete_node_names
 from orchestra.errors import OrchestraError
 
 _FILE = re.compile(r"^(?P<base>.+)-(?P<counter>\d+)(?:-stdout|-stderr)?\.log$")
@@ -31,7 +33,8 @@ def run_log_dir(master_uri: str) -> str:
             return str(launch["log_dir"])
     root = log_dir_root()
     try:
-        code, _, run_id = proxy(master_uri, timeout=2.0).getParam("/orchestra_logs", "/run_id")
+        answer: Any = proxy(master_uri, timeout=2.0).getParam("/orchestra_logs", "/run_id")
+        code, _, run_id = answer
         if code == 1 and isinstance(run_id, str) and os.path.isdir(os.path.join(root, run_id)):
             return os.path.join(root, run_id)
     except TRANSPORT_ERRORS:
@@ -90,7 +93,7 @@ def _follow(paths: list[str], interval: float = 0.2) -> Iterator[tuple[str, str]
 
 
 @click.command()
-@click.argument("node", required=False)
+@click.argument("node", required=False, shell_complete=complete_node_names)
 @click.option("-f", "--follow", is_flag=True, help="Keep printing what the files get (tail -f).")
 @click.option("-n", "--lines", "count", type=click.IntRange(min=0), default=20,
               show_default=True, help="Last lines of each file to print first.")

@@ -15,6 +15,7 @@ import time
 import click
 import yaml
 
+from orchestra.completion import complete_node_names
 from orchestra.errors import OrchestraError
 from orchestra.node import introspect
 from orchestra.node.exceptions import ROSException
@@ -293,7 +294,7 @@ _TIMEOUT = click.option("--timeout", type=click.FloatRange(min=0), default=30.0,
 
 
 @node.command("stop")
-@click.argument("names", nargs=-1, required=True)
+@click.argument("names", nargs=-1, required=True, shell_complete=complete_node_names)
 @_FORCE
 @_TIMEOUT
 def node_stop(names: tuple[str, ...], force: bool, timeout: float) -> None:
@@ -307,7 +308,7 @@ def node_stop(names: tuple[str, ...], force: bool, timeout: float) -> None:
 
 
 @node.command("start")
-@click.argument("names", nargs=-1, required=True)
+@click.argument("names", nargs=-1, required=True, shell_complete=complete_node_names)
 @_TIMEOUT
 def node_start(names: tuple[str, ...], timeout: float) -> None:
     """Start NAMES again (stopped by hand, ended or failed) in the launch at ROS_MASTER_URI."""
@@ -315,7 +316,7 @@ def node_start(names: tuple[str, ...], timeout: float) -> None:
 
 
 @node.command("restart")
-@click.argument("names", nargs=-1, required=True)
+@click.argument("names", nargs=-1, required=True, shell_complete=complete_node_names)
 @_TIMEOUT
 def node_restart(names: tuple[str, ...], timeout: float) -> None:
     """Stop NAMES (SIGINT, then SIGTERM, SIGKILL) and start them again; the rest runs on."""
@@ -324,7 +325,7 @@ def node_restart(names: tuple[str, ...], timeout: float) -> None:
 
 @node.command("signal")
 @click.argument("sig", metavar="SIGNAL")
-@click.argument("names", nargs=-1, required=True)
+@click.argument("names", nargs=-1, required=True, shell_complete=complete_node_names)
 def node_signal(sig: str, names: tuple[str, ...]) -> None:
     """Send SIGNAL (USR1, SIGHUP, 10...) to NAMES of the launch at ROS_MASTER_URI."""
     _control("signal", names, sig=sig)
