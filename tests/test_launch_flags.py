@@ -202,3 +202,18 @@ def test_summary_equals_real_roslaunchs_for_the_turtle_tf_demo(tmp_path):
     assert "turtle1_tf_broadcaster (turtle_tf/turtle_tf_broadcaster.py)" in expected
     assert _summary_block(out) == expected
     print(expected)
+
+
+def test_undeclared_command_line_arg_is_warned_with_a_suggestion(env, tmp_path):
+    (tmp_path / "ws" / "demo" / "nodes" / "done").write_text("#!/bin/sh\nexit 0\n")
+    (tmp_path / "ws" / "demo" / "nodes" / "done").chmod(0o755)
+    (tmp_path / "args.launch").write_text(
+        '<launch><arg name="driver" default="teleop"/><group><arg name="speed" default="1"/>'
+        '</group><node pkg="demo" type="done" name="job" required="true"/></launch>')
+    cli = subprocess.run([sys.executable, "-m", "orchestra", "launch", str(tmp_path / "args.launch"),
+                          "drivr:=auto", "speed:=2", "--no-status", "--no-rosout"], env=env,
+                         capture_output=True, text=True, timeout=60)
+    assert cli.returncode == 0, cli.stderr
+    assert ("orchestra: warning: arg 'drivr' is not declared by the launch file (roslaunch "
+            "ignores it) (did you mean driver?)") in cli.stderr
+    assert "'speed'" not in cli.stderr

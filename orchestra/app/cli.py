@@ -281,6 +281,10 @@ def launch(ctx: click.Context, words: tuple[str, ...], dump_plan: bool, dump_par
         node = find_declared(plan, find_node)
         click.echo(node.filename or "")
     else:
+        from orchestra.launch.load import undeclared_args
+
+        for warning in undeclared_args(paths, args):
+            echo_err(f"orchestra: {warning}")
         sys.exit(serve_plan(plan, options_from_cli(run_opts), cli_only))
 
 

@@ -87,6 +87,29 @@ def find_node(plan: Any, name: str) -> Any:
     return found[0]
 
 
+def undeclared_args(paths: list[str], args: dict[str, str]) -> list[str]:
+    """Warnings for command-line ``name:=value`` args no launch file declares, each with a
+    "did you mean". roslaunch ignores such an arg silently, so a typo (``drivr:=auto``)
+    runs the launch with the default; the run is the same here, but the user is told."""
+    from orchestra.launch.frontends import parse_file
+    from orchestra.suggest import did_you_mean
+
+    declared: set[str] = set()
+
+    def collect(entity: Any) -> None:
+        for child in entity.children:
+            if child.tag == "arg" and "name" in child.attributes:
+                declared.add(child.attributes["name"])
+            elif child.tag not in ("include", "node", "test"):
+                collect(child)       # <group>s: their args take command-line values too
+
+    for path in paths:
+        if path != "-" and os.path.isfile(path):
+            collect(parse_file(path))
+    return [f"warning: arg '{name}' is not declared by the launch file (roslaunch ignores it)"
+            f"{did_you_mean(name, declared)}" for name in sorted(set(args) - declared)]
+
+
 def ros_args_text(paths: list[str], args: dict[str, str]) -> str:
     from orchestra.launch.frontends import parse_file, parse_string
     from orchestra.launch.interpreter import declared_args
