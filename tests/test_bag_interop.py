@@ -172,7 +172,7 @@ def test_bag_written_by_real_rosbag_has_the_same_info(peers, tmp_path, compressi
     path = tmp_path / f"real_{compression}.bag"
     made = peers.ros_python(WRITE_BAG, str(path), compression)
     assert made.returncode == 0, made.stderr
-    for flags in ([], ["--yaml"]):
+    for flags in ([], ["--yaml"], ["--freq"], ["--yaml", "--freq"]):
         real = peers.rosbag("info", *flags, str(path))
         ours = peers.orchestra_run("bag", "info", *flags, str(path))
         assert real.returncode == ours.returncode == 0, (real.stderr, ours.stderr)

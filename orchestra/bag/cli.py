@@ -56,14 +56,16 @@ def bag() -> None:
 @bag.command("info")
 @click.argument("files", nargs=-1, required=True)
 @click.option("-y", "--yaml", "as_yaml", is_flag=True, help="Print information as YAML.")
-def info(files: tuple[str, ...], as_yaml: bool) -> None:
+@click.option("--freq", is_flag=True, help="Show each topic's median message rate (reads "
+              "the whole bag).")
+def info(files: tuple[str, ...], as_yaml: bool, freq: bool) -> None:
     """Summarize the contents of one or more bag files (as rosbag info)."""
     from orchestra.bag import info as info_mod
     from orchestra.bag.reader import BagReader
     for i, path in enumerate(files):
         with bag_errors(path):
             with BagReader(path) as reader:
-                summary = info_mod.summarize(path, reader)
+                summary = info_mod.summarize(path, reader, freq)
         click.echo(info_mod.yaml_text(summary) if as_yaml else info_mod.text(summary))
         if i < len(files) - 1:
             click.echo("---")

@@ -18,6 +18,7 @@ class TopicSummary:
     type: str
     messages: int
     connections: int
+    frequency: float | None = None  # median rate (--freq), None when not computed
 
 
 @dataclass
@@ -44,7 +45,9 @@ def _to_sec(ns: int) -> float:
     return float(ns // 1_000_000_000) + float(ns % 1_000_000_000) / 1e9
 
 
-def summarize(path: str, reader: BagReader) -> BagSummary:
+def summarize(path: str, reader: BagReader, freq: bool = False) -> BagSummary:
+    """The summary; ``freq`` also reads every message stamp for the median rates
+    (rosbag info --freq), which means reading the whole bag."""
     s = BagSummary(path=path, size=reader.file_size)
     if not reader.chunk_infos:
         return s
@@ -66,7 +69,31 @@ def summarize(path: str, reader: BagReader) -> BagSummary:
         conns = [c for c in reader.connections if c.topic == topic]
         s.topics.append(TopicSummary(topic, conns[0].type, sum(counts.get(c.id, 0)
                                                                 for c in conns), len(conns)))
+    if freq:
+        stamps: dict[str, list[float]] = {}
+        for conn, stamp, _data in reader.messages():
+            stamps.setdefault(conn.topic, []).append(_to_sec(stamp))
+        for t in s.topics:
+            t.frequency = median_rate(stamps.get(t.topic, []))
     return s
+
+
+def median_rate(stamps: list[float]) -> float | None:
+    """1 / the median gap between consecutive stamps (rosbag's even-length median)."""
+    if len(stamps) < 2:
+        return None
+    gaps = sorted(b - a for a, b in zip(stamps, stamps[1:], strict=False))
+    n = len(gaps)
+    mid = gaps[n // 2] if n % 2 else (gaps[n // 2 - 1] + gaps[n // 2]) / 2
+    return 1.0 / mid if mid > 0.0 else None
+
+
+def human_rate(freq: float) -> str:
+    for suffix in ("Hz", "kHz", "MHz", "GHz", "THz", "PHz", "EHz", "ZHz", "YHz"):
+        if freq < 1000.0:
+            return f"{freq:.1f} {suffix}"
+        freq /= 1000.0
+    return "-"
 
 
 def human_size(size: float) -> str:
@@ -136,9 +163,13 @@ def text(s: BagSummary) -> str:
         rows.append(("types" if i == 0 else "", f"{type_:<{type_w}} [{md5}]"))
     topic_w = max(len(t.topic) for t in s.topics)
     count_w = max(len(str(t.messages)) for t in s.topics)
+    freq_w = max((len(human_rate(t.frequency)) for t in s.topics if t.frequency is not None),
+                 default=0)
     for i, t in enumerate(s.topics):
+        rate = (f" @ {human_rate(t.frequency):>{freq_w}}" if t.frequency is not None
+                else f"   {'':>{freq_w}}")
         line = (f"{t.topic:<{topic_w}}   {t.messages:>{count_w}} "
-                f"{'msgs' if t.messages > 1 else 'msg '}    : {t.type:<{type_w}}")
+                f"{'msgs' if t.messages > 1 else 'msg '}{rate} : {t.type:<{type_w}}")
         if t.connections > 1:
             line += f" ({t.connections} connections)"
         rows.append(("topics" if i == 0 else "", line))
@@ -170,4 +201,6 @@ def yaml_text(s: BagSummary) -> str:
         out += [f"    - topic: {t.topic}", f"      type: {t.type}", f"      messages: {t.messages}"]
         if t.connections > 1:
             out.append(f"      connections: {t.connections}")
+        if t.frequency is not None:
+            out.append(f"      frequency: {t.frequency:.4f}")
     return "\n".join(out) + "\n"
