@@ -496,3 +496,14 @@ def test_record_onto_a_full_disk_stops_with_one_line_and_a_valid_bag(master, tmp
             if proc is not None:
                 proc.kill()
         subprocess.run(["umount", str(mnt)], capture_output=True)
+
+
+def test_record_buffer_drops_the_oldest_messages_beyond_buffsize(tmp_path):
+    from types import SimpleNamespace
+
+    from orchestra.bag.record import Recorder, RecordOptions
+    rec = Recorder(RecordOptions(topics=["/x"], name=str(tmp_path / "b"), buffsize=100))
+    for i in range(5):
+        rec._on_message(SimpleNamespace(_buff=bytes([i]) * 40, _connection_header={}), "/x")
+    assert rec.dropped == 3
+    assert [item[3][0] for item in rec._queue] == [3, 4]
