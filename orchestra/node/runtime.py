@@ -23,8 +23,6 @@ from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING, Any
 from urllib.parse import urlparse
 
-import yaml
-
 from orchestra.node import context, names, rostime, tcpros
 from orchestra.node.exceptions import (
     ROSException,
@@ -387,8 +385,8 @@ def init_node(name: str, argv: list[str] | None = None, anonymous: bool = False,
             _previous_handlers[sig] = signal.signal(sig, _on_signal)
     for key, text in parsed.private_params.items():
         try:
-            value = yaml.safe_load(text) if text != "" else ""
-        except yaml.YAMLError:
+            value = _yaml().safe_load(text) if text != "" else ""
+        except _yaml().YAMLError:
             value = text
         runtime.master_retry("setParam", runtime.resolve_name("~" + key), value)
     if not disable_rosout:
@@ -397,6 +395,13 @@ def init_node(name: str, argv: list[str] | None = None, anonymous: bool = False,
         runtime.clock_sub = _follow_clock()
     # as rospy: every node offers them (disable_rosout or not; rospy has no flag for them)
     runtime.logger_services = _offer_logger_services()
+
+
+def _yaml() -> Any:
+    """PyYAML, for ``_param:=value`` words only: most nodes have none, and importing it is a
+    tenth of the runtime's import time (bench/bench_rospy_layer.py)."""
+    import yaml
+    return yaml
 
 
 def _param_is_true(runtime: NodeRuntime, key: str) -> bool:
