@@ -153,13 +153,16 @@ def test_topics_cross_both_ways_std_msgs_and_the_packages_own_person(mixed):
 
 @pytest.mark.timeout(120)
 def test_services_and_actions_cross_both_ways(mixed):
+    # the tutorial's client is no node: real rospy ignores remappings there (they apply from
+    # init_node on; orchestra applies them, docs/compat.md), so the real client finds the
+    # layer's server under the tutorial's own name
     mixed.real("add_two_ints_server.py", "__name:=real_adder", "add_two_ints:=/real_adds")
-    mixed.layer("add_two_ints_server.py", "__name:=layer_adder", "add_two_ints:=/layer_adds")
+    mixed.layer("add_two_ints_server.py", "__name:=layer_adder")
     mixed.real("fibonacci_server.py", "__name:=real_fibonacci")
     mixed.layer("fibonacci_server.py", "__name:=layer_fibonacci")
     clients = [
         mixed.layer("add_two_ints_client.py", "3", "4", "add_two_ints:=/real_adds"),
-        mixed.real("add_two_ints_client.py", "5", "6", "add_two_ints:=/layer_adds"),
+        mixed.real("add_two_ints_client.py", "5", "6"),
         mixed.layer("fibonacci_client.py", "__name:=layer_fib_client", "_server:=/real_fibonacci",
                     "_order:=6"),
         mixed.real("fibonacci_client.py", "__name:=real_fib_client", "_server:=/layer_fibonacci",

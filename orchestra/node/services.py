@@ -9,21 +9,24 @@ one call; a persistent one carries calls until the client closes it.
 from __future__ import annotations
 
 import logging
+import os
 import socket
+import sys
 import threading
 import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
-from orchestra.node import context, tcpros
+from orchestra.node import context, names, tcpros
 from orchestra.node.exceptions import (
     ROSException,
     ROSInterruptException,
     ServiceException,
     TransportException,
 )
-from orchestra.node.masterapi import MasterError
+from orchestra.node.masterapi import Master, MasterError
 from orchestra.node.msg import Message, ServiceDefinition
+from orchestra.rpc import master_uri_from_env
 
 if TYPE_CHECKING:
     from orchestra.node.runtime import NodeRuntime
@@ -188,12 +191,43 @@ def _open(runtime_name: str, master, name: str, srv_class: type[ServiceDefinitio
     return sock, header
 
 
+class NoNode:
+    """What a service client works with when the process is not a node (yet): rospy lets a
+    script call services without ``init_node`` (the tutorials' add_two_ints_client does).
+    The caller id is rospy's ``/unnamed``; names resolve in ``__ns:=``/ROS_NAMESPACE with
+    the command line's remappings (rospy ignores them until ``init_node``: docs/compat.md);
+    the master is ``__master:=``/ROS_MASTER_URI's."""
+
+    def __init__(self, argv: list[str] | None = None):
+        parsed = names.parse_args(list(sys.argv if argv is None else argv))
+        special = parsed.special
+        self.name = "/unnamed"
+        self.namespace = names.make_global_ns(special.get("__ns")
+                                              or os.environ.get("ROS_NAMESPACE") or "/")
+        self.remaps = names.resolve_remaps(parsed.remaps, self.namespace, self.name)
+        self.master = Master(special.get("__master") or master_uri_from_env(), self.name)
+
+    def resolve_name(self, name: str) -> str:
+        if not names.is_legal_name(name):
+            raise ValueError(f"illegal ROS name: {name!r}")
+        return names.resolve(name, self.namespace, self.name, self.remaps)
+
+    def is_shutdown(self) -> bool:
+        return False
+
+
+def client_context() -> NodeRuntime | NoNode:
+    """This process's node, or a ``NoNode`` before ``init_node``."""
+    return context.current_or_none() or NoNode()
+
+
 class ServiceProxy:
     """Call a service: ``proxy(request)`` or ``proxy(**fields)`` returns the response."""
 
     def __init__(self, name: str, service_class: type[ServiceDefinition],
                  persistent: bool = False, headers: dict | None = None):
-        self._rt = context.current()
+        # as in rospy, a script need not be a node to call a service
+        self._rt = client_context()
         self.resolved_name = self.name = self._rt.resolve_name(name)
         self.service_class = service_class
         self.request_class = service_class._request_class
@@ -252,8 +286,9 @@ class ServiceProxy:
 
 def wait_for_service(service: str, timeout: float | None = None) -> None:
     """Block until ``service`` is registered and answers a probe; ``ROSException`` on
-    timeout (``timeout``: seconds or a Duration, None to wait for ever)."""
-    rt = context.current()
+    timeout (``timeout``: seconds or a Duration, None to wait for ever). Works before
+    ``init_node`` too, as in rospy."""
+    rt = client_context()
     resolved = rt.resolve_name(service)
     if timeout is not None and not isinstance(timeout, (int, float)):
         timeout = timeout.to_sec()

@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
-# The beginner tutorials' service client: add_two_ints_client.py X Y, logs the sum.
+# The beginner tutorials' service client: add_two_ints_client.py X Y prints the sum. As in
+# the tutorial it never calls init_node: rospy lets a plain script call services. (It reads
+# rospy.myargv() rather than sys.argv so that roslaunch's __name:= words do not count.)
 from __future__ import print_function
 
 import sys
-
 import rospy
 from beginner_tutorials.srv import *
 
@@ -23,7 +24,6 @@ def usage():
 
 
 if __name__ == "__main__":
-    rospy.init_node('add_two_ints_client', anonymous=True)
     argv = rospy.myargv()
     if len(argv) == 3:
         x = int(argv[1])
@@ -32,6 +32,5 @@ if __name__ == "__main__":
         print(usage())
         sys.exit(1)
     req = AddTwoIntsRequest(a=x, b=y)
-    rospy.loginfo("Requesting %s+%s", req.a, req.b)
-    rospy.loginfo("%s + %s = %s", x, y, add_two_ints_client(x, y))
-    rospy.sleep(0.5)  # let /rosout take the line before the node goes
+    print("Requesting %s+%s" % (req.a, req.b))
+    print("%s + %s = %s" % (x, y, add_two_ints_client(x, y)))
