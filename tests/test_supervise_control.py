@@ -228,3 +228,14 @@ def test_memory_limit_kills_a_node_allocating_past_it_and_says_why(running):
     assert "memory-limit of 300 MiB" in proc.reason
     assert b"memory-limit" in run.err.getvalue()
     assert run.state("/b") == State.RUNNING
+
+
+def test_cpu_limit_is_enforced_or_reported_as_not_enforced(running):
+    from orchestra.supervise.limits import cgroup_unavailable
+
+    run = running([spec("/busy", limits=Limits(cpu=0.5))])
+    problem = cgroup_unavailable()
+    if problem is None:
+        pytest.skip("a writable cgroup v2 with the cpu controller: enforced, not reported")
+    assert f"cpu-limit of /busy not enforced: {problem}".encode() in run.err.getvalue()
+    assert run.state("/busy") == State.RUNNING

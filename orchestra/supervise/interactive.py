@@ -30,7 +30,7 @@ from rich.text import Text
 
 from orchestra.supervise.loop import EventLoop
 from orchestra.supervise.output import Screen
-from orchestra.supervise.status import _duration, _size
+from orchestra.supervise.status import format_duration, format_size
 from orchestra.supervise.supervisor import ControlError, Supervisor
 
 logger = logging.getLogger(__name__)
@@ -250,9 +250,9 @@ class InteractiveView:
                 ("> " if name == current else "  ") + name,
                 Text(n["state"], style=_STATE_STYLE.get(n["state"], "")),
                 "-" if n["pid"] is None else str(n["pid"]), str(n["restarts"]),
-                _duration(n["uptime"]) if n["pid"] is not None else "-",
+                format_duration(n["uptime"]) if n["pid"] is not None else "-",
                 "-" if n["cpu_percent"] is None else f"{n['cpu_percent']:.1f}",
-                _size(n["rss"]), "; ".join(notes),
+                format_size(n["rss"]), "; ".join(notes),
                 style="reverse" if name == current else None)
         status = (f"filter: {self.editing}_" if self.editing is not None
                   else (f"[filter: {self.filter}] " if self.filter else "") + KEYS_HELP)

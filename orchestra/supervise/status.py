@@ -88,7 +88,7 @@ def snapshot(procs: list[ManagedProcess], stats: ProcessStats, info: dict[str, A
     return {"version": SNAPSHOT_VERSION, "pid": os.getpid(), **info, "nodes": nodes}
 
 
-def _duration(seconds: float) -> str:
+def format_duration(seconds: float) -> str:
     seconds = int(seconds)
     if seconds < 60:
         return f"{seconds}s"
@@ -97,7 +97,7 @@ def _duration(seconds: float) -> str:
     return f"{seconds // 3600}h{seconds // 60 % 60:02d}m"
 
 
-def _size(rss: int | None) -> str:
+def format_size(rss: int | None) -> str:
     if rss is None:
         return "-"
     size: float = rss
@@ -120,10 +120,10 @@ def table_lines(nodes: list[dict[str, Any]]) -> list[str]:
     for n, reason in zip(nodes, reasons, strict=True):
         cpu = "-" if n["cpu_percent"] is None else f"{n['cpu_percent']:.1f}"
         pid = "-" if n["pid"] is None else str(n["pid"])
-        uptime = _duration(n["uptime"]) if n["pid"] is not None else "-"
+        uptime = format_duration(n["uptime"]) if n["pid"] is not None else "-"
         why = f"  {reason}" if tail and reason else ""
         lines.append(f"{n['name']:<{width}}  {n['state']:<8} {pid:>7} {n['restarts']:>8} "
-                     f"{uptime:>8} {cpu:>6} {_size(n['rss']):>7}{why}")
+                     f"{uptime:>8} {cpu:>6} {format_size(n['rss']):>7}{why}")
     return lines
 
 
