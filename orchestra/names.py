@@ -10,7 +10,6 @@ from __future__ import annotations
 import os
 import random
 import re
-import socket
 import sys
 
 SEP = "/"
@@ -101,6 +100,8 @@ def resolve_name(name: str, ns: str = GLOBAL_NS, node_name: str | None = None) -
 
 
 def _host_token() -> str:
+    import socket  # here: the CLI's start-up path imports this module, rarely an $(anon)
+
     return socket.gethostname()
 
 

@@ -7,7 +7,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from orchestra.errors import OrchestraError
-from orchestra.params.dump import LaunchParamsDumper, _c_emits_the_same, dump_launch_params
+from orchestra.params.dump_launch import LaunchParamsDumper, _c_emits_the_same, dump_launch_params
 from orchestra.params.yaml import flatten, load_rosparam_yaml
 
 

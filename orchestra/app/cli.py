@@ -259,7 +259,7 @@ def launch(ctx: click.Context, words: tuple[str, ...], dump_plan: bool, dump_par
     if dump_plan:
         click.echo(_dump_json(plan))
     elif dump_params:
-        from orchestra.params.dump import dump_launch_params
+        from orchestra.params.dump_launch import dump_launch_params
 
         # roslaunch prints the YAML document (which ends in a newline) with print(), so its
         # output ends in an empty line; scripts diff the two, so match it byte for byte
