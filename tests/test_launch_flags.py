@@ -217,3 +217,17 @@ def test_undeclared_command_line_arg_is_warned_with_a_suggestion(env, tmp_path):
     assert ("orchestra: warning: arg 'drivr' is not declared by the launch file (roslaunch "
             "ignores it) (did you mean driver?)") in cli.stderr
     assert "'speed'" not in cli.stderr
+
+
+def test_ui_without_a_terminal_falls_back_to_plain_output(env, tmp_path):
+    (tmp_path / "ws" / "demo" / "nodes" / "done").write_text("#!/bin/sh\necho finished\n")
+    (tmp_path / "ws" / "demo" / "nodes" / "done").chmod(0o755)
+    (tmp_path / "job.launch").write_text(
+        '<launch><node pkg="demo" type="done" name="job" required="true" output="screen"/>'
+        '</launch>')
+    cli = subprocess.run([sys.executable, "-m", "orchestra", "launch", str(tmp_path / "job.launch"),
+                          "--ui", "--no-rosout", "--no-summary"], env=env, stdin=subprocess.DEVNULL,
+                         capture_output=True, text=True, timeout=60)
+    assert cli.returncode == 0, cli.stderr
+    assert "--ui: stdin and stdout are not both a terminal; plain output" in cli.stderr
+    assert "[/job] finished\n" in cli.stdout and "\x1b[" not in cli.stdout

@@ -237,6 +237,21 @@ def test_node_list_info_and_kill(nodes):
     assert unknown.returncode == 1 and "unknown node [/ghost]" in unknown.stderr
 
 
+def test_node_stop_falls_back_to_the_slave_api_for_nodes_not_launched_by_orchestra(
+        nodes, tmp_path):
+    pub = nodes.start("pub.py", "chatter", "std_msgs/String", "data: a", "--name", "talker")
+    pub.ready()
+    env = dict(nodes.env, XDG_RUNTIME_DIR=str(tmp_path))     # no orchestra launch here
+    stop = subprocess.run([sys.executable, "-m", "orchestra", "node", "stop", "/talker"],
+                          env=env, capture_output=True, text=True, timeout=60)
+    assert stop.returncode == 0, stop.stderr
+    assert "killing /talker (not started by orchestra" in stop.stdout
+    assert pub.wait() == 0
+    ghost = subprocess.run([sys.executable, "-m", "orchestra", "node", "restart", "/talker"],
+                           env=env, capture_output=True, text=True, timeout=60)
+    assert ghost.returncode == 2 and "no node /talker in any orchestra launch" in ghost.stderr
+
+
 def test_graph_writes_dot_and_svg_with_nodes_and_topics(nodes, tmp_path):
     nodes.start("pub.py", "chatter", "std_msgs/String", "data: a", "--name", "talker").ready()
     nodes.start("sub.py", "chatter", "std_msgs/String", "--name", "listener").ready()

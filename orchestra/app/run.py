@@ -403,6 +403,8 @@ class LaunchRun:
             supervisor.on_change = ui.changed
             supervisor.loop.call_later(0, ui.start)
             self._closers.append(ui.close)
+        elif opts.ui:
+            self._report("--ui: stdin and stdout are not both a terminal; plain output")
         elif view_on:
             view = LiveView(supervisor.loop, screen, make_snapshot)
             supervisor.on_change = view.changed
