@@ -23,6 +23,7 @@ import sys
 import threading
 from dataclasses import dataclass
 
+from orchestra import rosdirs
 from orchestra.node import msgspec
 
 log = logging.getLogger(__name__)
@@ -69,9 +70,9 @@ def _store_file() -> str | None:
 
 
 def _cache_path(store_file: str) -> str | None:
-    from orchestra.packages.cache import default_cache_dir
-
-    directory = default_cache_dir()
+    # rosdirs, not orchestra.packages: this runs in every node's init_node (/rosout's Log),
+    # and importing the package index there cost a node ~10 ms (bench_rospy_layer.py)
+    directory = rosdirs.cache_dir()
     if directory is None:
         return None
     st = os.stat(store_file)

@@ -18,6 +18,7 @@ import logging
 import os
 from collections.abc import Mapping
 
+from orchestra import rosdirs
 from orchestra.packages.crawl import Record
 
 log = logging.getLogger(__name__)
@@ -31,15 +32,8 @@ KEEP_FILES = 100
 
 
 def default_cache_dir(environ: Mapping[str, str] | None = None) -> str | None:
-    """``$ROS_HOME/orchestra``, else ``~/.ros/orchestra``; None when no home can be found."""
-    env = os.environ if environ is None else environ
-    ros_home = env.get("ROS_HOME")
-    if ros_home:
-        return os.path.join(ros_home, "orchestra")
-    home = os.path.expanduser("~")  # falls back to the password database when HOME is unset
-    if not home or home == "~":
-        return None
-    return os.path.join(home, ".ros", "orchestra")
+    """Where the index cache lives (``orchestra.rosdirs.cache_dir``)."""
+    return rosdirs.cache_dir(environ)
 
 
 def cache_file(cache_dir: str, root: str) -> str:
