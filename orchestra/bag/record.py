@@ -92,6 +92,7 @@ class Recorder:
         self.files: list[str] = []
         self._counts: dict[str, int] = {}
         self._subscribed: dict[str, object] = {}
+        self._named: list[str] = []  # the topics named on the command line, resolved
         self._writer: BagWriter | None = None
         self._part_started = 0.0
         self._threads: list[threading.Thread] = []
@@ -103,8 +104,9 @@ class Recorder:
         self._open_part()
         rospy.init_node(self.opts.node_name, argv=[], anonymous=True, disable_signals=True,
                         disable_rosout=True)
-        for topic in self.opts.topics:
-            self._subscribe(rospy.resolve_name(topic))
+        self._named = [rospy.resolve_name(topic) for topic in self.opts.topics]
+        for topic in self._named:
+            self._subscribe(topic)
         self._spawn(self._write_loop, "bag-writer")
         if self.opts.all or self._include is not None:
             self._spawn(self._discover_loop, "bag-discovery")
@@ -213,11 +215,9 @@ class Recorder:
             if seen >= limit:
                 return
             self._counts[topic] = seen + 1
-            if seen + 1 == limit:
-                self._subscribed.pop(topic, None)
-                if not (self.opts.all or self._include) and all(
-                        self._counts.get(t, 0) >= limit for t in self.opts.topics):
-                    self.stopping.set()
+            if seen + 1 == limit and not (self.opts.all or self._include) and all(
+                    self._counts.get(t, 0) >= limit for t in self._named):
+                self.stopping.set()
         writer = self._writer
         assert writer is not None
         conn = writer.add_connection(topic, {k: v for k, v in header.items() if k != "error"})
