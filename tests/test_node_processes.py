@@ -3,8 +3,8 @@ from __future__ import annotations
 
 import signal
 import socket
+import subprocess
 import sys
-import time
 import xmlrpc.client
 from pathlib import Path
 
@@ -40,10 +40,23 @@ def test_subscriber_receives_string_messages_from_publisher(nodes):
     assert msg != sub.messages()  # a stream, not one repeated message
 
 
+def _subscribers(nodes, topic: str) -> list[str]:
+    """The nodes the master lists as subscribed to ``topic``."""
+    _, _, (_, subscribers, _) = nodes.master().getSystemState("/test")
+    return [n for t, names in subscribers if t == topic for n in names]
+
+
+def _live_connections(nodes, node: str, topic: str) -> list:
+    """``node``'s connected inbound connections on ``topic`` (its slave API's bus info)."""
+    _, _, uri = nodes.master().lookupNode("/test", node)
+    _, _, info = xmlrpc.client.ServerProxy(uri).getBusInfo("/test")
+    return [c for c in info if c[4] == topic and c[2] == "i" and c[5]]
+
+
 def test_publisher_started_after_subscriber_is_found_via_publisher_update(nodes):
     sub = nodes.start("sub.py", "late", "geometry_msgs/Twist")
     sub.ready()
-    time.sleep(0.3)
+    wait_for(lambda: _subscribers(nodes, "/late"))  # registered before the publisher exists
     pub = nodes.start("pub.py", "late", "geometry_msgs/Twist", "{linear: {x: 1.5}, angular: {z: -2}}")
     pub.ready()
     msg = sub.messages()
@@ -118,13 +131,13 @@ def test_wrong_md5_on_connect_gets_an_error_header(nodes):
 
 def test_subscriber_survives_dead_publisher_and_reconnects_when_it_returns(nodes):
     sub = nodes.start("sub.py", "flaky", "std_msgs/String")
-    sub.ready()
+    name = sub.ready()["ready"]
     first = nodes.start("pub.py", "flaky", "std_msgs/String", "data: first", "--name", "talker")
     first.ready()
     assert sub.messages() == {"data": "first"}
     first.signal(signal.SIGKILL)  # dies without unregistering
     first.wait()
-    time.sleep(0.5)
+    wait_for(lambda: not _live_connections(nodes, name, "/flaky"))  # the drop was noticed
     assert sub.proc.poll() is None
     second = nodes.start("pub.py", "flaky", "std_msgs/String", "data: second", "--name", "talker")
     second.ready()
@@ -286,8 +299,8 @@ def test_node_started_before_the_master_waits_for_it(package_path):
     group = Nodes(f"http://127.0.0.1:{port}/", package_path)
     try:
         sub = group.start("sub.py", "early", "std_msgs/String")
-        time.sleep(1.0)
-        assert sub.proc.poll() is None
+        with pytest.raises(subprocess.TimeoutExpired):  # it waits for the master, no exit
+            sub.proc.wait(1.0)
         handle = start_master(host="127.0.0.1", port=port)
         try:
             assert sub.ready()["topic"] == "/early"
