@@ -71,6 +71,13 @@ def proxy(uri: str, timeout: float | None = None) -> xmlrpc.client.ServerProxy:
     return xmlrpc.client.ServerProxy(uri, transport=transport)
 
 
+def call(uri: str, method: str, *args: Any, timeout: float | None = None) -> Any:
+    """``method(*args)`` at ``uri`` on a connection of its own, closed afterwards (a
+    proxy otherwise holds its socket until it is garbage-collected)."""
+    with proxy(uri, timeout) as server:
+        return getattr(server, method)(*args)
+
+
 def unpack_reply(result: object) -> tuple[int, str, Any]:
     """A ROS XML-RPC answer ``[code, statusMessage, value]`` checked for its shape.
 

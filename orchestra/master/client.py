@@ -17,6 +17,7 @@ from orchestra.rpc import (
     DEFAULT_PORT,
     TRANSPORT_ERRORS,
     MasterUnreachable,
+    call,
     master_uri_from_env,
     multicall_results,
     proxy,
@@ -41,7 +42,7 @@ def port_from_uri(uri: str) -> int:
 def master_is_up(uri: str, timeout: float = 1.0) -> bool:
     """True when something at ``uri`` answers ``getPid`` like a ROS master."""
     try:
-        code, _, _ = unpack_reply(proxy(uri, timeout).getPid("/orchestra"))
+        code, _, _ = unpack_reply(call(uri, "getPid", "/orchestra", timeout=timeout))
     except TRANSPORT_ERRORS:
         return False
     except (xmlrpc.client.Fault, ValueError, TypeError):  # something else answers there
@@ -59,15 +60,15 @@ def upload_params(master_uri: str, params: Mapping[str, Any], clear_params: Sequ
     """
     for name, value in params.items():
         check_value(name, value)
-    server = proxy(master_uri, timeout=30.0)
-    multi = xmlrpc.client.MultiCall(server)
-    for ns in clear_params:
-        multi.deleteParam(caller_id, ns)
     names = list(params)
-    for name in names:
-        multi.setParam(caller_id, name, params[name])
     try:
-        results = multicall_results(multi)
+        with proxy(master_uri, timeout=30.0) as server:
+            multi = xmlrpc.client.MultiCall(server)
+            for ns in clear_params:
+                multi.deleteParam(caller_id, ns)
+            for name in names:
+                multi.setParam(caller_id, name, params[name])
+            results = multicall_results(multi)
     except xmlrpc.client.Fault as exc:
         raise OrchestraError(f"master at {master_uri} refused the parameters: "
                              f"{exc.faultString}") from None

@@ -10,8 +10,9 @@ from __future__ import annotations
 import xmlrpc.client
 from typing import Any
 
+from orchestra import rpc
 from orchestra.node.exceptions import ROSException
-from orchestra.rpc import TRANSPORT_ERRORS, proxy
+from orchestra.rpc import TRANSPORT_ERRORS
 
 DEFAULT_TIMEOUT = 10.0
 
@@ -27,7 +28,7 @@ class MasterError(ROSException):
 def raw_call(uri: str, method: str, *args: Any, timeout: float = DEFAULT_TIMEOUT) -> list:
     """``[code, msg, value]`` from ``method`` at ``uri``; unreachable -> MasterError."""
     try:
-        result = getattr(proxy(uri, timeout), method)(*args)
+        result = rpc.call(uri, method, *args, timeout=timeout)
     except TRANSPORT_ERRORS as exc:
         raise MasterError(f"cannot reach {uri} ({method}): {exc}") from exc
     except xmlrpc.client.Fault as exc:

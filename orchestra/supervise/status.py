@@ -17,7 +17,7 @@ from typing import Any
 
 import psutil
 
-from orchestra.rpc import proxy, unpack_reply
+from orchestra.rpc import call, unpack_reply
 from orchestra.supervise.loop import EventLoop, Timer
 from orchestra.supervise.process import ManagedProcess, State
 
@@ -321,7 +321,7 @@ def launches_on_master(master_uri: str, timeout: float = 3.0) -> list[dict[str, 
     """
     try:
         code, _, uris = unpack_reply(
-            proxy(master_uri, timeout).getParam("/orchestra_status", "/roslaunch/uris"))
+            call(master_uri, "getParam", "/orchestra_status", "/roslaunch/uris", timeout=timeout))
     except (OSError, xmlrpc.client.Error):
         raise OSError(f"no master answers at {master_uri}") from None
     if code != 1 or not isinstance(uris, dict):
@@ -330,7 +330,7 @@ def launches_on_master(master_uri: str, timeout: float = 3.0) -> list[dict[str, 
     for key in sorted(uris):
         try:
             code, _, doc = unpack_reply(
-                proxy(str(uris[key]), timeout).orchestra_status("/orchestra_status"))
+                call(str(uris[key]), "orchestra_status", "/orchestra_status", timeout=timeout))
             if code == 1:
                 found.append(json.loads(doc))
         except (OSError, xmlrpc.client.Error, ValueError):
