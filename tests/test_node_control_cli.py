@@ -150,3 +150,41 @@ def test_node_names_of_the_running_launch_complete(env, launch):
     out = subprocess.run([sys.executable, "-m", "orchestra"], env=environ,
                          capture_output=True, text=True, timeout=60).stdout
     assert out.splitlines() == ["plain,/g/c"]
+
+
+def test_control_reaches_every_launch_sharing_the_master(env, tmp_path):
+    import json
+
+    core = subprocess.Popen([sys.executable, "-m", "orchestra", "core", "--no-rosout"],
+                            env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    second = tmp_path / "ws" / "demo" / "launch" / "second.launch"
+    second.write_text('<launch><node pkg="demo" type="sleeper" name="x"/>'
+                      '<group ns="g"><node pkg="demo" type="sleeper" name="y"/></group></launch>')
+    runs = []
+    try:
+        wait_for(lambda: orchestra(env, "param", "get", "/rosversion").returncode == 0)
+        runs.append(Launch(env))
+        runs.append(subprocess.Popen([sys.executable, "-m", "orchestra", "launch", "demo",
+                                      "second.launch", "--no-status"], env=env,
+                                     stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+
+        def everyone() -> dict:
+            docs = json.loads(orchestra(env, "status", "--json").stdout or "[]")
+            return {n["name"]: (n["state"], n["pid"]) for d in docs for n in d["nodes"]}
+
+        wait_for(lambda: len(everyone()) == 5
+                 and all(s == "RUNNING" for s, _ in everyone().values()), timeout=30)
+        before = everyone()
+        cli = orchestra(env, "node", "restart", "/g")
+        assert cli.returncode == 0, cli.stderr
+        after = everyone()
+        assert after["/g/c"][1] != before["/g/c"][1] and after["/g/y"][1] != before["/g/y"][1]
+        assert after["/a"] == before["/a"] and after["/x"] == before["/x"]
+        cli = orchestra(env, "node", "stop", "/x")
+        assert cli.returncode == 0 and "/x: STOPPED" in cli.stdout, cli.stdout + cli.stderr
+    finally:
+        if runs:
+            runs[0].close()
+        for proc in (*runs[1:], core):
+            proc.send_signal(signal.SIGINT)
+            proc.wait(timeout=30)

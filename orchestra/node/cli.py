@@ -204,30 +204,25 @@ class _Unknown(OrchestraError):
     """Names matching no node of the launch nor of the graph: a user mistake (exit 2)."""
 
 
-def _launch_here(uri: str) -> dict | None:
-    """The running orchestra launch (of this user) whose master is at ``uri``."""
-    from orchestra.supervise.status import launches_at
-
-    found = launches_at(uri)
-    return found[0] if found else None
-
-
 def _control(op: str, names: tuple[str, ...], force: bool = False, sig: str = "",
              timeout: float = 30.0) -> None:
-    """Ask the launch at ROS_MASTER_URI to act on NAMES, then wait until they settled.
+    """Ask the launches at ROS_MASTER_URI to act on NAMES, then wait until they settled.
 
-    Names the launch does not know but the master does (nodes started by something else)
-    are stopped the way ``node kill`` does; anything else is unknown: exit 2, nothing done.
+    Several orchestra launches may share one master (``orchestra core`` and two launch
+    files): each NAME goes to every launch it matches nodes of. Names no launch knows but
+    the master does (nodes started by something else) are stopped the way ``node kill``
+    does; anything else is unknown: exit 2, nothing done.
     """
     from orchestra.suggest import did_you_mean
     from orchestra.supervise.control import matches
-    from orchestra.supervise.status import request
+    from orchestra.supervise.status import launches_at, request
 
     uri = _master_uri()
-    launch = _launch_here(uri)
-    ours = [n["name"] for n in launch["nodes"]] if launch else []
-    mine = [n for n in names if matches(n, ours)]
-    foreign = [n for n in names if n not in mine]
+    launches = launches_at(uri)
+    ours = [n["name"] for launch in launches for n in launch["nodes"]]
+    plan = [(launch, [n for n in names if matches(n, [x["name"] for x in launch["nodes"]])])
+            for launch in launches]
+    foreign = [n for n in names if not matches(n, ours)]
     if foreign:
         graph: list[str] = []
         if op == "stop":
@@ -237,15 +232,15 @@ def _control(op: str, names: tuple[str, ...], force: bool = False, sig: str = ""
                 graph = []
         missing = [n for n in foreign if _global(n) not in graph]
         if missing:
-            where = "this launch" if launch else f"any orchestra launch at {uri}"
+            where = "this launch" if launches else f"any orchestra launch at {uri}"
             raise _Unknown("\n".join(f"no node {_global(n)} in {where}"
                                       f"{did_you_mean(_global(n), ours + graph)}"
                                       for n in missing))
-    answer: dict = {"ok": True, "done": []}
-    if mine:
-        assert launch is not None  # names are ours only when a launch answered
+    for launch, mine in plan:
+        if not mine:
+            continue
         before = {n["name"]: n for n in launch["nodes"]}
-        body: dict = {"op": op, "names": list(mine), "force": force}
+        body: dict = {"op": op, "names": mine, "force": force}
         if sig:
             body["signal"] = sig
         try:
