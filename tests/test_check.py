@@ -415,3 +415,14 @@ def test_an_include_chain_longer_than_the_stack_is_checked_without_a_traceback(w
     report = check_files([str(ws / "launch" / "f0.launch")])
     assert [p.message for p in report.problems if p.severity == ERROR] == [
         f"<include> attribute 'file': includes nest more than {MAX_INCLUDE_DEPTH} files deep"]
+
+
+def test_eval_functions_are_not_args_and_refused_grammar_is_reported_statically(ws):
+    path = write(ws / "launch", "a.launch",
+                 '<launch>\n  <param name="a" value="$(eval radians(90) + pi)"/>\n'
+                 '  <group if="false">\n'
+                 '    <param name="b" value="$(eval (lambda: 1)())"/>\n  </group>\n</launch>\n')
+    report = check_files([path])
+    assert codes(report, ERROR) == []
+    problem = only(report, "bad-substitution")
+    assert problem.location.line == 4 and "lambda expressions are not allowed" in problem.message
