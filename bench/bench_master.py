@@ -1,38 +1,33 @@
-"""Master throughput: parameter calls per second and getSystemState at 1,000 registrations.
+"""Master throughput: orchestra's master against the real rosmaster, both as processes.
 
-Plain Python, no pytest. Every figure is measured in this run next to a baseline measured the
-same way in the same run, so ratios stay meaningful on a busy machine:
+Plain Python, no pytest. Both masters run as separate processes started the same way and
+pinned to the same CPU (``orchestra core -p PORT --no-rosout`` and ``rosmaster --core -p
+PORT``), and are filled and called by the same client code in this process
+(``xmlrpc.client``, like rospy): per-call rates of getParam/setParam, getParam('/') with
+1,000 params, getSystemState with 1,000 registrations, and the time of 1,000 sequential
+registerPublisher calls and of one multicall of 1,000 setParam. Every measurement is taken
+``--rounds`` times, interleaved between the two masters; the tables show medians. Skipped
+with a message when /usr/bin/rosmaster is missing (orchestra's figures still print).
 
-- baseline "stdlib no-op": a threaded stdlib SimpleXMLRPCServer speaking HTTP/1.0 (one TCP
-  connection per call, like rosmaster's server) whose method returns [1, "", 0] at once;
-  this is the cost of an XML-RPC round trip with no master logic at all.
-- baseline "keep-alive no-op": the same no-op method on orchestra's server class, to separate
-  the transport gain from the master's own cost.
-
-- the real ROS 1 rosmaster (Debian's, ``rosmaster --core -p PORT`` on a free port), filled
-  and called by the same client code as orchestra's master: the baseline users care about.
-  Skipped with a message when /usr/bin/rosmaster is missing.
-
-Usage: ``python bench/bench_master.py [--quick] [--seconds 1.0]``
+Usage: ``python bench/bench_master.py [--quick] [--seconds 1.0] [--rounds 5] [--cpu N]``
 """
 from __future__ import annotations
 
 import argparse
 import os
+import shutil
 import socket
-import socketserver
+import statistics
 import subprocess
 import sys
-import threading
 import time
 import xmlrpc.client
-from xmlrpc.server import SimpleXMLRPCServer
-
-from orchestra.master import start_master, upload_params
-from orchestra.master.server import ThreadedXMLRPCServer
+from collections.abc import Callable
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import ros1  # noqa: E402
+
+PIN: list[str] = []
 
 
 def rate(fn, seconds: float) -> float:
@@ -51,35 +46,20 @@ def rate(fn, seconds: float) -> float:
             return calls / (now - start)
 
 
-class _StdlibThreaded(socketserver.ThreadingMixIn, SimpleXMLRPCServer):
-    daemon_threads = True
-
-
-def _serve(server) -> threading.Thread:
-    thread = threading.Thread(target=server.serve_forever, kwargs={"poll_interval": 0.1},
-                              daemon=True)
-    thread.start()
-    return thread
-
-
-def _noop(caller_id, key):
-    return [1, "", 0]
-
-
 def free_port() -> int:
     with socket.socket() as sock:
         sock.bind(("127.0.0.1", 0))
         return sock.getsockname()[1]
 
 
-class RealRosmaster:
-    """``rosmaster --core -p PORT`` (ROS 1) on a free port; stop() kills it and its children."""
+class MasterProcess:
+    """A master as its own process on a free port; stop() kills it and its children."""
 
-    def __init__(self) -> None:
+    def __init__(self, argv: list[str], env: dict[str, str]) -> None:
         self.port = free_port()
         self.uri = f"http://127.0.0.1:{self.port}/"
-        self.proc = subprocess.Popen([ros1.tool("rosmaster"), "--core", "-p", str(self.port)],
-                                     env=ros1.base_env(ROS_MASTER_URI=self.uri),
+        env = {**env, "ROS_MASTER_URI": self.uri}
+        self.proc = subprocess.Popen([*PIN, *argv, "-p", str(self.port)], env=env,
                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                                      start_new_session=True)
         deadline = time.monotonic() + 30
@@ -90,7 +70,7 @@ class RealRosmaster:
             except OSError:
                 if self.proc.poll() is not None or time.monotonic() > deadline:
                     self.stop()
-                    raise RuntimeError("rosmaster did not come up") from None
+                    raise RuntimeError(f"{argv[0]} did not come up") from None
                 time.sleep(0.05)
 
     def stop(self) -> None:
@@ -98,16 +78,24 @@ class RealRosmaster:
         self.proc.wait(10)
 
 
-def populate(param_uri: str, graph_uri: str, n: int) -> tuple[float, float]:
-    """1,000 params on one master, ``n`` registrations on the other; seconds for each."""
+def orchestra_master() -> MasterProcess:
+    return MasterProcess([sys.executable, "-m", "orchestra", "core", "--no-rosout"],
+                         dict(os.environ))
+
+
+def real_rosmaster() -> MasterProcess:
+    return MasterProcess([ros1.tool("rosmaster") or "rosmaster", "--core"], ros1.base_env())
+
+
+def populate(param_uri: str, graph_uri: str, n: int) -> None:
+    """1,000 params on one master, ``n`` registrations (pub/sub/service) on the other."""
     m = xmlrpc.client.ServerProxy(param_uri)
     g = xmlrpc.client.ServerProxy(graph_uri)
     m.setParam("/bench", "/robot/gain", 1.5)
-    params = {f"/ns{i % 10}/node{i}/param": i for i in range(1000)}
-    start = time.perf_counter()
-    upload_params(param_uri, params, ["/ns0"])
-    upload_s = time.perf_counter() - start
-    start = time.perf_counter()
+    multi = xmlrpc.client.MultiCall(m)
+    for i in range(1000):
+        multi.setParam("/bench", f"/ns{i % 10}/node{i}/param", i)
+    multi()
     for i in range(n):
         node = f"/node{i}"
         api = f"http://127.0.0.1:{20000 + i}/"
@@ -118,112 +106,100 @@ def populate(param_uri: str, graph_uri: str, n: int) -> tuple[float, float]:
             g.registerSubscriber(node, f"/topic{i % 100}_in", "std_msgs/String", api)
         else:
             g.registerService(node, f"/srv{i}", f"rosrpc://127.0.0.1:{30000 + i}", api)
-    register_s = time.perf_counter() - start
     state = g.getSystemState("/b")[2]
     assert sum(len(ids) for section in state for _, ids in section) == n
-    return upload_s, register_s
 
 
-def client_cases(param_uri: str, graph_uri: str, n: int) -> list:
+def register_publishers(uri: str, n: int, round_no: int) -> float:
+    """Seconds for ``n`` sequential registerPublisher calls (new topics every round)."""
+    g = xmlrpc.client.ServerProxy(uri)
+    start = time.perf_counter()
+    for i in range(n):
+        g.registerPublisher(f"/pub{i}", f"/r{round_no}/topic{i}", "std_msgs/String",
+                            f"http://127.0.0.1:{40000 + i % 20000}/")
+    return time.perf_counter() - start
+
+
+def multicall_set(uri: str, n: int, round_no: int) -> float:
+    """Seconds for one system.multicall of ``n`` setParam calls."""
+    multi = xmlrpc.client.MultiCall(xmlrpc.client.ServerProxy(uri))
+    for i in range(n):
+        multi.setParam("/bench", f"/multi/r{round_no}/p{i}", i)
+    start = time.perf_counter()
+    results = list(multi())
+    took = time.perf_counter() - start
+    assert len(results) == n
+    return took
+
+
+def rate_cases(param_uri: str, graph_uri: str, n: int) -> list[tuple[str, Callable[[], object]]]:
     """The calls measured on any master, through one client (xmlrpc.client, like rospy)."""
     m = xmlrpc.client.ServerProxy(param_uri)
     g = xmlrpc.client.ServerProxy(graph_uri)
     counter = iter(range(10 ** 9))
     return [
-        ("getParam (leaf)", lambda: m.getParam("/bench", "/robot/gain")),
-        ("setParam (leaf)", lambda: m.setParam("/bench", "/robot/gain", next(counter))),
-        ("getParam('/') with 1,000 params", lambda: m.getParam("/b", "/")),
-        (f"getSystemState with {n:,} registrations", lambda: g.getSystemState("/b")),
+        ("getParam (leaf), calls/s", lambda: m.getParam("/bench", "/robot/gain")),
+        ("setParam (leaf), calls/s", lambda: m.setParam("/bench", "/robot/gain", next(counter))),
+        ("getParam('/') with 1,000 params, calls/s", lambda: m.getParam("/b", "/")),
+        (f"getSystemState with {n:,} registrations, calls/s", lambda: g.getSystemState("/b")),
     ]
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=None,
-                        help="time per measurement (default 1.0; 0.3 with --quick)")
-    parser.add_argument("--rounds", type=int, default=3,
-                        help="measure everything this many times, interleaved; keep the best "
-                             "(the machine is shared: the best round is the least disturbed)")
+                        help="time per rate measurement (default 1.0; 0.3 with --quick)")
+    parser.add_argument("--rounds", type=int, default=5,
+                        help="measure everything this many times, interleaved; medians")
     parser.add_argument("--registrations", type=int, default=1000)
+    parser.add_argument("--cpu", type=int, default=None,
+                        help="pin both masters to this CPU (default: the last; -1: no pinning)")
     parser.add_argument("--quick", action="store_true", help="shorter measurements")
     args = parser.parse_args()
     seconds = args.seconds or (0.3 if args.quick else 1.0)
     n = args.registrations
+    cpu = (os.cpu_count() or 1) - 1 if args.cpu is None else args.cpu
+    if cpu >= 0 and shutil.which("taskset"):
+        PIN[:] = ["taskset", "-c", str(cpu)]
     print(ros1.load_average())
-
-    stdlib = _StdlibThreaded(("127.0.0.1", 0), logRequests=False)
-    stdlib.register_function(_noop, "noop")
-    _serve(stdlib)
-    keepalive = ThreadedXMLRPCServer(("127.0.0.1", 0))
-    keepalive.register_function(_noop, "noop")
-    _serve(keepalive)
-    master = start_master(port=0)   # parameters and a leaf to read/write
-    graph = start_master(port=0)    # 1,000 registrations
-    real: list[RealRosmaster] = []
+    sides: dict[str, list[MasterProcess]] = {}
     try:
+        sides["orchestra"] = [orchestra_master(), orchestra_master()]
         if ros1.tool("rosmaster") is None:
             ros1.skip("the real rosmaster", "rosmaster (ROS 1)")
         else:
-            real = [RealRosmaster(), RealRosmaster()]
-        p_std = xmlrpc.client.ServerProxy(f"http://127.0.0.1:{stdlib.server_address[1]}/")
-        p_ka = xmlrpc.client.ServerProxy(f"http://127.0.0.1:{keepalive.server_address[1]}/")
-        upload_s, register_s = populate(master.uri, graph.uri, n)
-        if real:
-            r_upload_s, r_register_s = populate(real[0].uri, real[1].uri, n)
-
-        # the master's own share of a big reply: dispatch plus XML encoding, without the
-        # client's (pure-Python) XML parsing that dominates the round trip
-        def server_side(api, method, *call_args):
-            return lambda: xmlrpc.client.dumps((api._dispatch(method, call_args),),
-                                               methodresponse=True)
-        ours = client_cases(master.uri, graph.uri, n)
-        cases = [
-            ("stdlib no-op (HTTP/1.0, rosmaster transport)", lambda: p_std.noop("/b", "/k")),
-            ("orchestra server no-op (keep-alive)", lambda: p_ka.noop("/b", "/k")),
-            *ours[:3],
-            ("  same, server side only (dispatch + encode)",
-             server_side(master.api, "getParam", "/b", "/")),
-            ours[3],
-            ("  same, server side only (dispatch + encode)",
-             server_side(graph.api, "getSystemState", "/b")),
-        ]
-        theirs = client_cases(real[0].uri, real[1].uri, n) if real else []
-        best = [0.0] * len(cases)
-        best_real = [0.0] * len(theirs)
-        for _ in range(args.rounds):
-            for i, (_, fn) in enumerate(cases):
-                best[i] = max(best[i], rate(fn, seconds / args.rounds))
-            for i, (_, fn) in enumerate(theirs):
-                best_real[i] = max(best_real[i], rate(fn, seconds / args.rounds))
+            sides["rosmaster"] = [real_rosmaster(), real_rosmaster()]
+        for params, graph in sides.values():
+            populate(params.uri, graph.uri, n)
+        names = [name for name, _ in rate_cases("http://x/", "http://x/", n)]
+        names += ["1,000 registerPublisher, sequential, ms", "multicall of 1,000 setParam, ms"]
+        results: dict[str, list[list[float]]] = {side: [[] for _ in names] for side in sides}
+        for round_no in range(args.rounds):
+            for side, (params, graph) in sides.items():   # interleaved
+                cases = rate_cases(params.uri, graph.uri, n)
+                for i, (_, fn) in enumerate(cases):
+                    results[side][i].append(rate(fn, seconds))
+                results[side][len(cases)].append(
+                    register_publishers(graph.uri, 1000, round_no) * 1e3)
+                results[side][len(cases) + 1].append(multicall_set(params.uri, 1000, round_no) * 1e3)
     finally:
-        for server in (stdlib, keepalive):
-            server.shutdown()
-            server.server_close()
-        master.shutdown()
-        graph.shutdown()
-        for proc in real:
-            proc.stop()
+        for masters in sides.values():
+            for master in masters:
+                master.stop()
 
-    base = best[0]
-    width = max(len(name) for name, _ in cases)
-    print(f"{'measurement':<{width}}  {'calls/s':>9}  {'ms/call':>8}  {'x baseline':>10}")
-    for (name, _), value in zip(cases, best, strict=False):
-        print(f"{name:<{width}}  {value:9.0f}  {1000 / value:8.3f}  {value / base:10.2f}")
-    print(f"upload_params: 1,000 params + 1 clear in one multicall: {upload_s * 1000:.1f} ms")
-    print(f"{n:,} registrations (pub/sub/service mix), sequential: {register_s * 1000:.0f} ms "
-          f"({n / register_s:.0f}/s)")
-    if real:
-        ours_by_name = dict(zip([name for name, _ in cases], best, strict=False))
-        print(f"\n{'same client, calls/s':<{width}}  {'orchestra':>9}  {'rosmaster':>9}  "
-              f"{'ratio':>6}")
-        for (name, _), value in zip(theirs, best_real, strict=False):
-            mine = ours_by_name[name]
-            print(f"{name:<{width}}  {mine:9.0f}  {value:9.0f}  {mine / value:5.1f}x")
-        print(f"{'upload_params, 1,000 params (ms)':<{width}}  {upload_s * 1e3:9.1f}  "
-              f"{r_upload_s * 1e3:9.1f}  {r_upload_s / upload_s:5.1f}x")
-        print(f"{f'{n:,} registrations, sequential (ms)':<{width}}  {register_s * 1e3:9.0f}  "
-              f"{r_register_s * 1e3:9.0f}  {r_register_s / register_s:5.1f}x")
-        print("ratio = orchestra throughput / rosmaster throughput (higher: orchestra faster)")
+    width = max(len(name) for name in names)
+    med = {side: [statistics.median(v) for v in values] for side, values in results.items()}
+    print(f"\n{'median of ' + str(args.rounds) + ' rounds':<{width}}  {'orchestra':>10}  "
+          f"{'rosmaster':>10}  {'ratio':>6}")
+    for i, name in enumerate(names):
+        ours = med["orchestra"][i]
+        if "rosmaster" in med:
+            theirs = med["rosmaster"][i]
+            print(f"{name:<{width}}  {ours:10.1f}  {theirs:10.1f}  {ours / theirs:5.2f}x")
+        else:
+            print(f"{name:<{width}}  {ours:10.1f}")
+    print("ratio = orchestra / rosmaster (calls/s rows: higher is faster; ms rows: lower is "
+          "faster)")
     print(ros1.load_average())
 
 
