@@ -136,3 +136,15 @@ def test_frames_as_string_and_yaml():
 def test_transform_listener_needs_a_buffer():
     with pytest.raises(TypeError):
         tf2_ros.TransformListener(object())
+
+
+def test_latest_common_time_is_the_newest_stamp_both_chains_share_and_clear_forgets():
+    buffer = tf2_ros.Buffer()
+    buffer.set_transform(stamped("world", "a", Time(5)), "test")
+    buffer.set_transform(stamped("world", "a", Time(9)), "test")
+    buffer.set_transform(stamped("world", "b", Time(7)), "test")
+    assert buffer.get_latest_common_time("a", "b") == Time(7)
+    buffer.clear()
+    assert not buffer.can_transform("a", "b", Time())
+    with pytest.raises(tf2_ros.LookupException):
+        buffer.get_latest_common_time("a", "b")

@@ -127,6 +127,12 @@ class TransformBuffer:
             edge.insert(float(stamp), transform, self.cache_time)
             self._lock.notify_all()
 
+    def clear(self) -> None:
+        """Forget every transform (tf's ``clear``, e.g. after the clock jumped back)."""
+        with self._lock:
+            self._edges.clear()
+            self._graph.clear()
+
     # --- reading -----------------------------------------------------------------------------
 
     def frames(self) -> list[str]:

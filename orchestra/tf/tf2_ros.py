@@ -153,6 +153,19 @@ class Buffer:
             return (False, str(exc)) if debug else False
         return (True, "") if debug else True
 
+    def get_latest_common_time(self, target_frame: str, source_frame: str) -> Any:
+        """The newest time both frames' chains have data for (a ROS Time; 0 for a static
+        chain), tf2's ``getLatestCommonTime``."""
+        from orchestra.node.rostime import Time
+
+        _check_frames(target_frame=target_frame, source_frame=source_frame)
+        _, used = self.tree.lookup(target_frame, source_frame, 0.0)
+        return Time.from_sec(used)
+
+    def clear(self) -> None:
+        """Forget every transform (a listener keeps filling the same buffer)."""
+        self.tree.clear()
+
     # --- introspection -----------------------------------------------------------------------
 
     def all_frames_as_string(self) -> str:

@@ -56,7 +56,7 @@ class Transformer:
         self._buffer.set_transform(parent, child, stamp, values)
 
     def clear(self) -> None:
-        self._buffer = TransformBuffer(cache_time=self._buffer.cache_time)
+        self._buffer.clear()
 
     def frameExists(self, frame_id: str) -> bool:  # noqa: N802
         return frame_id.lstrip("/") in self._buffer.frames()
@@ -172,10 +172,6 @@ class TransformListener(Transformer):
     def __init__(self, interpolate: bool = True, cache_time: Any = None):
         super().__init__(interpolate, cache_time)
         self._feed = _listener.TransformListener(self._buffer)
-
-    def clear(self) -> None:
-        super().clear()
-        self._feed.buffer = self._buffer
 
 
 class TransformBroadcaster(_broadcaster.TransformBroadcaster):
