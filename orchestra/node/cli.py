@@ -649,14 +649,8 @@ def topic_pub(name: str, type_name: str, values: tuple[str, ...], rate: float | 
 
 def _drain(pub, deadline: float) -> None:
     """Wait until every connection's queue is written out (or the deadline passes)."""
-    impl = pub._impl
-    while time.monotonic() < deadline:
-        with impl.lock:
-            busy = any(c.queue for c in impl.connections)
-        if not busy:
-            time.sleep(0.05)  # let the kernel hand the last bytes over
-            return
-        time.sleep(0.01)
+    if pub.wait_sent(max(0.0, deadline - time.monotonic())):
+        time.sleep(0.05)  # let the kernel hand the last bytes over
 
 
 @topic.command("hz")

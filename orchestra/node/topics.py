@@ -15,6 +15,7 @@ import select
 import socket
 import struct
 import threading
+import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, cast
 
@@ -252,6 +253,20 @@ class Publisher:
 
     def get_num_connections(self) -> int:
         return self._impl.num_connections()
+
+    def wait_sent(self, timeout: float) -> bool:
+        """Wait until every message published so far has left its connection queues (an
+        orchestra extension: a short-lived publisher, ``orchestra topic pub -1``, must not
+        exit before then). False when ``timeout`` seconds passed first."""
+        deadline = time.monotonic() + timeout
+        while True:
+            with self._impl.lock:
+                busy = any(c.queue for c in self._impl.connections)
+            if not busy:
+                return True
+            if time.monotonic() >= deadline:
+                return False
+            time.sleep(0.01)
 
     def unregister(self) -> None:
         if not self._done:
