@@ -391,3 +391,34 @@ def test_a_script_that_is_no_node_calls_a_remapped_service(master):
         assert client.wait(10) == 0
     finally:
         group.close()
+
+
+# --- actionlib, the same as real actionlib ------------------------------------------------------
+
+EXPECTED_ACTIONS = [
+    {"server_found": [True, True]},
+    {"succeeded": [True, 3, 5, "added", [[3, 5]], True, 2]},
+    {"newer_ran": [True, 3, 9], "preempted_by_newer": [True, 2, -1]},
+    {"cancelled": [True, 2, "preempted"]},
+    {"states": [0, 3, 2]},
+]
+
+
+def action_run(master, python: str, env: dict[str, str]) -> list[dict]:
+    group = harness.ProcessGroup(master.uri)
+    try:
+        node = group._start([python, str(HERE / "actionlib_behaviours.py")],
+                            dict(env, ROS_MASTER_URI=master.uri, PYTHONUNBUFFERED="1"))
+        node.expect(lambda d: "states" in d, timeout=60)
+        return [d for d in node.seen if "text" not in d]
+    finally:
+        group.close()
+
+
+def test_simple_action_server_and_client_semantics_on_the_layer(master):
+    assert action_run(master, sys.executable, layer_env()) == EXPECTED_ACTIONS
+
+
+def test_simple_action_semantics_are_real_actionlibs(master):
+    need_real("rospy", "actionlib", "actionlib.msg")
+    assert action_run(master, ROS_PYTHON, real_env()) == EXPECTED_ACTIONS
