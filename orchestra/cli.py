@@ -64,6 +64,18 @@ COMMANDS: dict[str, tuple[str, str]] = {
 }
 
 
+def _short_help(text: str, limit: int) -> str:
+    """The first sentence of ``text``, cut at a word to ``limit`` characters with "...".
+
+    Written here because click 8.5 deprecates its own ``make_default_short_help``.
+    """
+    first = text.split(". ")[0].rstrip(".")
+    if len(first) <= limit:
+        return first
+    cut = first[: max(limit - 3, 1)].rsplit(" ", 1)[0]
+    return cut + "..."
+
+
 class LazyGroup(click.Group):
     """A click group that imports a sub-command's module only when that command is used;
     its help lists the commands from the table, importing none of them."""
@@ -77,8 +89,7 @@ class LazyGroup(click.Group):
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
         names = self.list_commands(ctx)
         limit = formatter.width - 6 - max(len(name) for name in names)
-        rows = [(name, click.utils.make_default_short_help(COMMANDS[name][1], limit))
-                for name in names]
+        rows = [(name, _short_help(COMMANDS[name][1], limit)) for name in names]
         with formatter.section("Commands"):
             formatter.write_dl(rows)
 

@@ -9,6 +9,7 @@ and the package path, so the listings include the standard packages even without
 """
 from __future__ import annotations
 
+import sys
 from collections.abc import Callable
 
 import click
@@ -49,7 +50,7 @@ def _from_stdin(value: str | None) -> str:
     the first non-empty line of stdin."""
     if value:
         return value
-    for line in click.get_text_stream("stdin"):
+    for line in sys.stdin:
         if line.strip():
             return line.strip()
     raise click.UsageError("give a type (or pipe one in, as from `orchestra topic type`)")
