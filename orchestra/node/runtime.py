@@ -389,12 +389,38 @@ def init_node(name: str, argv: list[str] | None = None, anonymous: bool = False,
         except _yaml().YAMLError:
             value = text
         runtime.master_retry("setParam", runtime.resolve_name("~" + key), value)
+    # as rospy: every node offers them (disable_rosout or not; rospy has no flag for them).
+    # Offered from a second thread while this one sets up /rosout and the clock: the
+    # master round trips overlap (a node's start-up is mostly waiting on them)
+    loggers = _Background(_offer_logger_services)
     if not disable_rosout:
         runtime.rosout = _make_rosout()
     if not disable_rostime and _param_is_true(runtime, "/use_sim_time"):
         runtime.clock_sub = _follow_clock()
-    # as rospy: every node offers them (disable_rosout or not; rospy has no flag for them)
-    runtime.logger_services = _offer_logger_services()
+    runtime.logger_services = loggers.result()
+
+
+class _Background:
+    """``fn()`` on its own thread; ``result()`` joins it and returns (or raises) its outcome."""
+
+    def __init__(self, fn: Callable[[], Any]):
+        self._value: Any = None
+        self._error: BaseException | None = None
+        self._thread = threading.Thread(target=self._run, args=(fn,), daemon=True,
+                                        name="node-start")
+        self._thread.start()
+
+    def _run(self, fn: Callable[[], Any]) -> None:
+        try:
+            self._value = fn()
+        except BaseException as exc:  # handed to the caller of result()
+            self._error = exc
+
+    def result(self) -> Any:
+        self._thread.join()
+        if self._error is not None:
+            raise self._error
+        return self._value
 
 
 def _yaml() -> Any:
