@@ -504,6 +504,7 @@ def test_record_buffer_drops_the_oldest_messages_beyond_buffsize(tmp_path):
 
     from orchestra.bag.record import Recorder, RecordOptions
     rec = Recorder(RecordOptions(topics=["/x"], name=str(tmp_path / "b"), buffsize=100))
+    rec._write_lock.acquire()  # the writer is busy: messages queue up
     for i in range(5):
         rec._on_message(SimpleNamespace(_buff=bytes([i]) * 40, _connection_header={}), "/x")
     assert rec.dropped == 3

@@ -84,6 +84,7 @@ class Recorder:
         self._queue: collections.deque = collections.deque()
         self._queued_bytes = 0
         self._cond = threading.Condition()
+        self._write_lock = threading.Lock()
         self.stopping = threading.Event()
         self.error: str | None = None
         self.messages = 0
@@ -137,7 +138,8 @@ class Recorder:
             self._cond.notify_all()
         for thread in self._threads:
             thread.join()
-        self._close_part()
+        with self._write_lock:
+            self._close_part()
 
     # --- subscriptions ----------------------------------------------------------------------
 
@@ -171,21 +173,39 @@ class Recorder:
             topic, AnyMsg, self._on_message, callback_args=topic, queue_size=0)
 
     def _on_message(self, msg, topic: str) -> None:
-        """A receive thread: stamp and queue (cheap; the writer thread does the rest)."""
+        """A receive thread: stamp, then write at once when nothing is queued and nobody is
+        writing (no hand-over to another thread: what makes large messages fast), else
+        queue for the writer thread. Order is kept: the writer thread takes the write lock
+        before it takes a batch, and a direct write needs an empty queue."""
         from orchestra.node.rostime import get_rostime
         stamp = get_rostime().to_nsec()
         data = msg._buff
         with self._cond:
             if self.stopping.is_set():
                 return
-            self._queue.append((stamp, topic, msg._connection_header, data))
-            self._queued_bytes += len(data)
-            while self._queued_bytes > self.opts.buffsize and len(self._queue) > 1:
-                old = self._queue.popleft()
-                self._queued_bytes -= len(old[3])
-                self.dropped += 1
-                log.warning("bag record buffer exceeded: dropping the oldest queued message")
-            self._cond.notify()
+            direct = not self._queue and self._write_lock.acquire(blocking=False)
+            if not direct:
+                self._enqueue((stamp, topic, msg._connection_header, data))
+                return
+        try:
+            if self._writer is not None:
+                self._write(stamp, topic, msg._connection_header, data)
+        except BagWriteError as exc:
+            self.error = str(exc)
+            self.stopping.set()
+        finally:
+            self._write_lock.release()
+
+    def _enqueue(self, item: tuple) -> None:
+        """Queue for the writer thread (``_cond`` held); beyond --buffsize the oldest go."""
+        self._queue.append(item)
+        self._queued_bytes += len(item[3])
+        while self._queued_bytes > self.opts.buffsize and len(self._queue) > 1:
+            old = self._queue.popleft()
+            self._queued_bytes -= len(old[3])
+            self.dropped += 1
+            log.warning("bag record buffer exceeded: dropping the oldest queued message")
+        self._cond.notify()
 
     # --- writing ----------------------------------------------------------------------------
 
@@ -194,19 +214,22 @@ class Recorder:
             with self._cond:
                 while not self._queue and not self.stopping.is_set():
                     self._cond.wait(0.5)
-                    self._maybe_split_idle()
+                    with self._write_lock:
+                        self._maybe_split_idle()
                 if not self._queue and self.stopping.is_set():
                     return
-                batch = list(self._queue)
-                self._queue.clear()
-                self._queued_bytes = 0
-            try:
-                for item in batch:
-                    self._write(*item)
-            except BagWriteError as exc:
-                self.error = str(exc)
-                self.stopping.set()
-                return
+            with self._write_lock:
+                with self._cond:
+                    batch = list(self._queue)
+                    self._queue.clear()
+                    self._queued_bytes = 0
+                try:
+                    for item in batch:
+                        self._write(*item)
+                except BagWriteError as exc:
+                    self.error = str(exc)
+                    self.stopping.set()
+                    return
 
     def _write(self, stamp: int, topic: str, header: dict[str, str], data: bytes) -> None:
         limit = self.opts.limit
