@@ -130,6 +130,15 @@ def _roslaunch_in_process(jobs: list, rounds: int) -> tuple[list, list]:
 PIN: list[str] = []
 
 
+def orchestra_script() -> str:
+    """The ``orchestra`` console script pip installed beside this interpreter (what a user's
+    PATH finds after ``pip install``), not a version manager's shim: pyenv's bash shims add
+    ~30 ms per process that are neither orchestra's nor roslaunch's (/usr/bin/roslaunch is
+    run directly)."""
+    beside = os.path.join(os.path.dirname(sys.executable), "orchestra")
+    return beside if os.access(beside, os.X_OK) else (shutil.which("orchestra") or "orchestra")
+
+
 def _pinned(argv: list[str]) -> list[str]:
     """``argv`` under the same ``taskset`` as every other measured process."""
     return [*PIN, *argv]
@@ -206,7 +215,7 @@ def bench_cases(samples: int, rounds: int, rows: list) -> None:
     o_sub, r_sub = [], []
     for i in sub_jobs:  # interleaved: each case through orchestra, then through roslaunch
         path, words, env = jobs[i]
-        t, ok = _subprocess_time(_pinned(["orchestra", "launch", "--dump-params", path,
+        t, ok = _subprocess_time(_pinned([orchestra_script(), "launch", "--dump-params", path,
                                           *words]), env)
         if ok:
             o_sub.append(t)
@@ -237,9 +246,9 @@ def bench_startup(samples: int, rows: list) -> None:
         one.write_text(ONE_NODE)
         env = dict(os.environ)
         runs = {"python -c pass": [sys.executable, "-c", "pass"],
-                "orchestra --help": ["orchestra", "--help"],
+                "orchestra --help": [orchestra_script(), "--help"],
                 "orchestra launch --dump-params one_node.launch":
-                    ["orchestra", "launch", "--dump-params", str(one)]}
+                    [orchestra_script(), "launch", "--dump-params", str(one)]}
         times: dict[str, list[float]] = {what: [] for what in runs}
         for _ in range(samples):  # interleaved
             for what, argv in runs.items():
@@ -341,7 +350,7 @@ def bench_synthetic(runs: int, rows: list) -> None:
                      f"{r_times[0] * 1e3:.0f} ms", best / r_times[0], "<= 0.2x"))
         o_ts, r_ts = [], []
         for _ in range(5):  # interleaved
-            o_t, o_ok = _subprocess_time(_pinned(["orchestra", "launch", "--dump-params",
+            o_t, o_ok = _subprocess_time(_pinned([orchestra_script(), "launch", "--dump-params",
                                                   str(main)]), env)
             r_t, r_ok = _subprocess_time(_pinned([roslaunch, "--dump-params", str(main)]),
                                          ros1.base_env(**env))
