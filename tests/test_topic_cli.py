@@ -164,6 +164,14 @@ def test_topic_hz_reports_the_average_rate(nodes):
     assert "\tmin: " in result.stdout and "window: " in result.stdout
 
 
+def test_topic_hz_with_a_window_keeps_reporting_the_rate(nodes):
+    nodes.start("pub.py", "fast", "std_msgs/Empty", "{}", "--rate", "50").ready()
+    result = orchestra(nodes, "topic", "hz", "/fast", "-w", "5", "-n", "3")
+    assert result.returncode == 0, result.stderr
+    assert "no new messages" not in result.stdout
+    assert result.stdout.count("window: 6") == 3
+
+
 def test_topic_hz_piped_prints_its_reports_and_ends_quietly_on_ctrl_c(nodes):
     import signal
 

@@ -669,12 +669,13 @@ def topic_hz(name: str, window: int | None, reports: int | None) -> None:
         _sub, inbox = _subscribe_raw(rospy, name)
         click.echo(f"subscribed to [{name}]")
         next_report = time.monotonic() + 1.0
-        last_count = 0
+        received = reported = 0  # counts, not len(stamps): a --window caps the list
         while reports is None or done < reports:
             timeout = max(0.0, next_report - time.monotonic())
             try:
                 stamp, _ = inbox.get(timeout=timeout)
                 stamps.append(stamp)
+                received += 1
                 keep = window if window is not None else 50000  # rostopic's default cap
                 if len(stamps) > keep + 1:
                     del stamps[:-keep - 1]
@@ -682,11 +683,11 @@ def topic_hz(name: str, window: int | None, reports: int | None) -> None:
             except queue.Empty:
                 pass
             next_report += 1.0
-            if len(stamps) < 2 or len(stamps) == last_count and not inbox.qsize():
+            if len(stamps) < 2 or received == reported and not inbox.qsize():
                 click.echo("no new messages")
             else:
                 click.echo(hz_report(stamps))
-            last_count = len(stamps)
+            reported = received
             done += 1
     except KeyboardInterrupt:
         pass
