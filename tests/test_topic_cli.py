@@ -36,6 +36,21 @@ def test_topic_echo_of_a_field_path_prints_just_that_field(nodes):
     assert result.stdout == "5.5\n---\n"
 
 
+def test_topic_echo_of_a_field_path_waits_for_the_topic_to_be_published(nodes):
+    echo = subprocess.Popen([sys.executable, "-m", "orchestra", "topic", "echo",
+                             "/late/linear/x", "-n", "1"], env=nodes.env, text=True,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    try:
+        assert "does not appear to be published yet" in echo.stderr.readline()
+        nodes.start("pub.py", "late", "geometry_msgs/Twist", "{linear: {x: 0.5}}",
+                    "--rate", "20").ready()
+        out, _ = echo.communicate(timeout=30)
+        assert out == "0.5\n---\n"
+    finally:
+        echo.kill()
+        echo.wait()
+
+
 def test_topic_echo_decodes_a_type_it_has_no_definition_for(nodes, package_path):
     nodes.start("pub.py", "nums", "test_msgs/Num", "{num: 4, label: four}").ready()
     env_without_pkg = dict(nodes.env, ROS_PACKAGE_PATH="")

@@ -534,9 +534,12 @@ def topic_echo(name: str, count: int | None, noarr: bool) -> None:
     printed = 0
     try:
         state = introspect.system_state(_master_uri())
-        name, fields = split_field_path(name, state.topics)
-        if name not in state.publishers:
-            click.echo(f"WARNING: topic [{name}] does not appear to be published yet", err=True)
+        topic, fields = split_field_path(name, state.topics)
+        if topic not in state.publishers:
+            click.echo(f"WARNING: topic [{topic}] does not appear to be published yet", err=True)
+        if topic not in state.topics:  # maybe TOPIC/FIELD: which part is the topic comes later
+            topic, fields = _wait_for_topic(name)
+        name = topic
         _sub, inbox = _subscribe_raw(rospy, name)
         while count is None or printed < count:
             try:
@@ -554,6 +557,18 @@ def topic_echo(name: str, count: int | None, noarr: bool) -> None:
         pass
     finally:
         _stop_cli_node("topic echo done")
+
+
+def _wait_for_topic(path: str) -> tuple[str, list[str]]:
+    """Poll the master until ``path`` or a prefix of it is a known topic, as rostopic echo
+    waits for the topic's type: only then can ``/cmd_vel/linear/x`` be split into topic
+    and fields."""
+    while True:
+        topics = introspect.system_state(_master_uri()).topics
+        topic, fields = split_field_path(path, topics)
+        if topic in topics:
+            return topic, fields
+        time.sleep(0.1)
 
 
 def hide_arrays(msg) -> None:
