@@ -9,7 +9,6 @@ command runs.
 from __future__ import annotations
 
 import contextlib
-import json
 import os
 import sys
 from collections.abc import Callable, Iterator
@@ -186,6 +185,8 @@ def serve_plan(plan: Any, options: Any, cli: dict[str, Any] | None = None) -> in
 def _dump_json(plan: Any) -> str:
     from orchestra.launch.interpreter import binary_to_json
     from orchestra.supervise.command import exec_table
+
+    import json
 
     doc = plan.to_json()
     doc["exec"] = exec_table(plan)
@@ -374,6 +375,8 @@ def status(as_json: bool, socket_path: str | None, use_master: bool,
     else:
         launches = launches_at(uri)
     if as_json:
+        import json
+
         click.echo(json.dumps(launches if not socket_path else launches[0], indent=1))
         return 0
     if not launches:

@@ -11,11 +11,8 @@ running that command at load time as roslaunch does (unless ``no_exec``).
 """
 from __future__ import annotations
 
-import base64
 import logging
 import os
-import shlex
-import subprocess
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -439,6 +436,9 @@ class Interpreter:
 
     def _run_command(self, entity: Entity, name: str, command: str) -> str:
         """roslaunch runs ``command=`` at load time, shell-split but without a shell."""
+        import shlex  # here, like subprocess: most loads run no command (CLI start-up time)
+        import subprocess
+
         try:
             argv = shlex.split(command)
         except ValueError as exc:
@@ -767,6 +767,8 @@ def load_launch(path: str, args: dict[str, str] | None = None, *, no_exec: bool 
 def binary_to_json(value: Any) -> Any:
     """JSON form of values the plan may hold that JSON lacks (bytes, dates)."""
     if isinstance(value, (bytes, bytearray)):
+        import base64
+
         return {"__binary_b64__": base64.b64encode(bytes(value)).decode("ascii")}
     if hasattr(value, "isoformat"):
         return value.isoformat()
