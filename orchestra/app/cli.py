@@ -183,10 +183,10 @@ def serve_plan(plan: Any, options: Any, cli: dict[str, Any] | None = None) -> in
 
 
 def _dump_json(plan: Any) -> str:
+    import json
+
     from orchestra.launch.interpreter import binary_to_json
     from orchestra.supervise.command import exec_table
-
-    import json
 
     doc = plan.to_json()
     doc["exec"] = exec_table(plan)
