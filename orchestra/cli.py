@@ -19,7 +19,7 @@ from orchestra.errors import OrchestraError
 COMMANDS: dict[str, tuple[str, str]] = {
     "launch": ("orchestra.app.cli:launch",
                "Resolve and run a roslaunch file: orchestra launch [PKG] FILE [name:=value ...]."),
-    "check": ("orchestra.launch.tools_cli:check",
+    "check": ("orchestra.app.checkcli:check",
               "Report every problem in launch files (and what they include), starting nothing."),
     "convert": ("orchestra.launch.tools_cli:convert",
                 "Convert a launch file (or every launch file under a directory) between XML and "
@@ -27,7 +27,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "export": ("orchestra.export.cli:export",
                "Write a launch file as units for another process manager (see docs/remote.md)."),
     "pkg": ("orchestra.packages.cli:pkg", "Find packages and their dependencies (like rospack)."),
-    "run": ("orchestra.packages.cli:run", "Run executable EXE of PACKAGE with ARGS (like rosrun)."),
+    "run": ("orchestra.ros1.cli:run", "Run executable EXE of PACKAGE with ARGS (like rosrun)."),
     "create-pkg": ("orchestra.packages.cli:create_pkg",
                    "Create catkin package NAME depending on DEPS (like catkin_create_pkg)."),
     "core": ("orchestra.app.cli:core",
@@ -44,7 +44,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "test": ("orchestra.app.cli:test_command",
              "Run a launch file's <test>s as rostest does: orchestra test [PKG] FILE "
              "[name:=value ...]."),
-    "node": ("orchestra.node.cli:node",
+    "node": ("orchestra.app.nodecli:node",
              "Running nodes: list, info, kill, ping, cleanup (like rosnode); loggers and "
              "set-logger-level (like rosconsole list/get/set)."),
     "topic": ("orchestra.node.cli:topic",

@@ -78,6 +78,20 @@ def call(uri: str, method: str, *args: Any, timeout: float | None = None) -> Any
         return getattr(server, method)(*args)
 
 
+def master_is_up(uri: str, timeout: float = 1.0) -> bool:
+    """True when something at ``uri`` answers ``getPid`` like a ROS master.
+
+    Here, not in master/, because the node tools ask it too and node/ sits below master/.
+    """
+    try:
+        code, _, _ = unpack_reply(call(uri, "getPid", "/orchestra", timeout=timeout))
+    except TRANSPORT_ERRORS:
+        return False
+    except (xmlrpc.client.Fault, ValueError, TypeError):  # something else answers there
+        return False
+    return code == 1
+
+
 def unpack_reply(result: object) -> tuple[int, str, Any]:
     """A ROS XML-RPC answer ``[code, statusMessage, value]`` checked for its shape.
 

@@ -7,10 +7,10 @@ graph here is read from the source (every ``import`` statement, at any depth) ra
 from what importing happens to load. Imports under ``if TYPE_CHECKING:`` are left out: they
 never run, they only name types for the checker.
 
-The command modules (``orchestra/cli.py``, ``<subpackage>/cli.py``, ``tools_cli.py``,
-``msgcli.py``) are the top layer of the picture (docs/architecture.md) whichever directory
-they sit in, beside the subject they drive: at subpackage level they count as that layer.
-The layering itself is checked by the import-linter contract in pyproject.toml.
+Every module counts in its subpackage, the command modules (``<subpackage>/cli.py``...)
+included: a command that needs a layer above its subject is composed in app/ (see
+docs/architecture.md). The layering itself is checked by the import-linter contract in
+pyproject.toml.
 """
 from __future__ import annotations
 
@@ -22,7 +22,6 @@ import networkx as nx
 
 ROOT = Path(__file__).resolve().parent.parent
 PACKAGE = ROOT / "orchestra"
-COMMANDS = "orchestra.<commands>"
 
 
 def _modules() -> dict[str, Path]:
@@ -84,9 +83,7 @@ def import_graph() -> nx.DiGraph:
 
 
 def subpackage(module: str) -> str:
-    """The subpackage a module belongs to at the layer level (command modules: their own)."""
-    if module.rpartition(".")[2].endswith("cli"):
-        return COMMANDS
+    """The subpackage a module belongs to (a top-level module is its own)."""
     return ".".join(module.split(".")[:2])
 
 

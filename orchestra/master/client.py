@@ -17,11 +17,10 @@ from orchestra.rpc import (
     DEFAULT_PORT,
     TRANSPORT_ERRORS,
     MasterUnreachable,
-    call,
+    master_is_up,
     master_uri_from_env,
     multicall_results,
     proxy,
-    unpack_reply,
 )
 
 __all__ = [
@@ -37,17 +36,6 @@ def port_from_uri(uri: str) -> int:
     except ValueError:
         raise OrchestraError(f"invalid master URI '{uri}' (expected http://host:port/)") from None
     return port if port is not None else DEFAULT_PORT
-
-
-def master_is_up(uri: str, timeout: float = 1.0) -> bool:
-    """True when something at ``uri`` answers ``getPid`` like a ROS master."""
-    try:
-        code, _, _ = unpack_reply(call(uri, "getPid", "/orchestra", timeout=timeout))
-    except TRANSPORT_ERRORS:
-        return False
-    except (xmlrpc.client.Fault, ValueError, TypeError):  # something else answers there
-        return False
-    return code == 1
 
 
 def upload_params(master_uri: str, params: Mapping[str, Any], clear_params: Sequence[str],

@@ -15,11 +15,11 @@ import time
 import click
 import yaml
 
-from orchestra.completion import complete_node_names
 from orchestra.errors import OrchestraError
 from orchestra.node import introspect
 from orchestra.node.exceptions import ROSException
 from orchestra.node.loggers import LEVEL_NAMES
+from orchestra.rpc import MasterUnreachable, master_is_up, master_uri_from_env
 
 CLI_NODE = "orchestra_cli"
 
@@ -31,18 +31,18 @@ class CommandFailed(OrchestraError):
 
 
 def _master_uri() -> str:
-    from orchestra.master import master_uri_from_env
     return master_uri_from_env()
 
 
 def _require_master(uri: str) -> None:
-    from orchestra.master import MasterUnreachable, master_is_up
     if not master_is_up(uri, timeout=2.0):
         raise MasterUnreachable(f"cannot contact the master at {uri} (is it running? "
                                 "check ROS_MASTER_URI)")
 
 
-def _global(name: str) -> str:
+def graph_name(name: str) -> str:
+    """A name as typed on the command line (``talker``, ``/ns/talker``) as a global graph
+    name; an illegal one is the user's mistake (exit 2)."""
     from orchestra.node.names import canonical, is_legal_name
     if not is_legal_name(name) or name.startswith("~"):
         raise OrchestraError(f"illegal graph name '{name}'")
@@ -120,7 +120,7 @@ def _bullets(items: list[str]) -> str:
 def node_info(name: str) -> None:
     """Publications, subscriptions, services and connections of NAME."""
     uri_master = _master_uri()
-    name = _global(name)
+    name = graph_name(name)
     state = introspect.system_state(uri_master)
     uri = introspect.lookup_node(uri_master, name)
     click.echo("-" * 80)
@@ -184,7 +184,7 @@ def _peer(master_uri: str, state, topic: str, dest: str, cache: dict) -> str:
 def node_kill(names: tuple[str, ...], kill_all: bool) -> None:
     """Ask NAMES to shut down (through their slave API, as rosnode kill does)."""
     uri = _master_uri()
-    targets = introspect.system_state(uri).nodes if kill_all else [_global(n) for n in names]
+    targets = introspect.system_state(uri).nodes if kill_all else [graph_name(n) for n in names]
     if not targets:
         raise OrchestraError("give the node names to kill, or --all")
     failed = []
@@ -200,133 +200,6 @@ def node_kill(names: tuple[str, ...], kill_all: bool) -> None:
     click.echo("killed")
 
 
-class _Unknown(OrchestraError):
-    """Names matching no node of the launch nor of the graph: a user mistake (exit 2)."""
-
-
-def _control(op: str, names: tuple[str, ...], force: bool = False, sig: str = "",
-             timeout: float = 30.0) -> None:
-    """Ask the launches at ROS_MASTER_URI to act on NAMES, then wait until they settled.
-
-    Several orchestra launches may share one master (``orchestra core`` and two launch
-    files): each NAME goes to every launch it matches nodes of. Names no launch knows but
-    the master does (nodes started by something else) are stopped the way ``node kill``
-    does; anything else is unknown: exit 2, nothing done.
-    """
-    from orchestra.suggest import did_you_mean
-    from orchestra.supervise.control import matches
-    from orchestra.supervise.status import launches_at, request
-
-    uri = _master_uri()
-    launches = launches_at(uri)
-    ours = [n["name"] for launch in launches for n in launch["nodes"]]
-    plan = [(launch, [n for n in names if matches(n, [x["name"] for x in launch["nodes"]])])
-            for launch in launches]
-    foreign = [n for n in names if not matches(n, ours)]
-    if foreign:
-        graph: list[str] = []
-        if op == "stop":
-            try:
-                graph = introspect.system_state(uri).nodes
-            except (OSError, introspect.GraphError, OrchestraError):
-                graph = []
-        missing = [n for n in foreign if _global(n) not in graph]
-        if missing:
-            where = "this launch" if launches else f"any orchestra launch at {uri}"
-            raise _Unknown("\n".join(f"no node {_global(n)} in {where}"
-                                      f"{did_you_mean(_global(n), ours + graph)}"
-                                      for n in missing))
-    for launch, mine in plan:
-        if not mine:
-            continue
-        before = {n["name"]: n for n in launch["nodes"]}
-        body: dict = {"op": op, "names": mine, "force": force}
-        if sig:
-            body["signal"] = sig
-        try:
-            answer = request(launch["socket"], body)
-        except (OSError, ValueError) as exc:
-            raise CommandFailed(f"the launch did not answer: {exc}") from None
-        if not answer.get("ok"):
-            raise (_Unknown if answer.get("unknown") else CommandFailed)(
-                str(answer.get("error")))
-        if op != "signal":
-            _wait_settled(launch["socket"], [n for n, _ in answer["done"]], before, timeout)
-    for name in foreign:
-        click.echo(f"killing {_global(name)} (not started by orchestra: asked to shut down)")
-        try:
-            introspect.kill_node(uri, _global(name))
-        except introspect.GraphError as exc:
-            raise CommandFailed(str(exc)) from None
-
-
-def _wait_settled(path: str, names: list[str], before: dict, timeout: float) -> None:
-    """Poll the launch until none of ``names`` is STOPPING/STARTING; print where each ended."""
-    from orchestra.supervise.status import query
-
-    deadline = time.monotonic() + timeout
-    while True:
-        nodes = {n["name"]: n for n in query(path)["nodes"]}
-        busy = [n for n in names if nodes[n]["state"] in ("STOPPING", "STARTING")]
-        if not busy or time.monotonic() > deadline:
-            break
-        time.sleep(0.05)
-    for name in names:
-        now, old = nodes[name], before.get(name, {})
-        pid = f" (pid {old.get('pid')} -> {now['pid']})" if old.get("pid") and now["pid"] \
-            else (f" (pid {now['pid']})" if now["pid"] else "")
-        click.echo(f"{name}: {now['state']}{pid}" + (f" - {now['reason']}" if now["reason"]
-                                                      and now["state"] != "RUNNING" else ""))
-    if busy:
-        raise CommandFailed(f"still {nodes[busy[0]]['state']} after {timeout:g} s: "
-                            + ", ".join(busy))
-
-
-_FORCE = click.option("-f", "--force", is_flag=True,
-                      help="Also stop required nodes (whose end otherwise stops the launch).")
-_TIMEOUT = click.option("--timeout", type=click.FloatRange(min=0), default=30.0,
-                        show_default=True, help="Seconds to wait for the nodes to settle.")
-
-
-@node.command("stop")
-@click.argument("names", nargs=-1, required=True, shell_complete=complete_node_names)
-@_FORCE
-@_TIMEOUT
-def node_stop(names: tuple[str, ...], force: bool, timeout: float) -> None:
-    """Stop NAMES of the launch at ROS_MASTER_URI; the rest keeps running.
-
-    A NAME is a node, a namespace (every node below it) or a glob (/cam*). A stopped node is
-    STOPPED until started again. Nodes not started by orchestra are asked to shut down, as
-    ``node kill`` does.
-    """
-    _control("stop", names, force=force, timeout=timeout)
-
-
-@node.command("start")
-@click.argument("names", nargs=-1, required=True, shell_complete=complete_node_names)
-@_TIMEOUT
-def node_start(names: tuple[str, ...], timeout: float) -> None:
-    """Start NAMES again (stopped by hand, ended or failed) in the launch at ROS_MASTER_URI."""
-    _control("start", names, timeout=timeout)
-
-
-@node.command("restart")
-@click.argument("names", nargs=-1, required=True, shell_complete=complete_node_names)
-@_TIMEOUT
-def node_restart(names: tuple[str, ...], timeout: float) -> None:
-    """Stop NAMES (SIGINT, then SIGTERM, SIGKILL) and start them again; the rest runs on."""
-    _control("restart", names, timeout=timeout)
-
-
-@node.command("signal")
-@click.argument("sig", metavar="SIGNAL")
-@click.argument("names", nargs=-1, required=True, shell_complete=complete_node_names)
-def node_signal(sig: str, names: tuple[str, ...]) -> None:
-    """Send SIGNAL (USR1, SIGHUP, 10...) to NAMES of the launch at ROS_MASTER_URI."""
-    _control("signal", names, sig=sig)
-    click.echo(f"sent {sig} to {', '.join(names)}")
-
-
 @node.command("ping")
 @click.argument("name")
 @click.option("-c", "count", type=click.IntRange(min=1), default=1, show_default=True,
@@ -334,7 +207,7 @@ def node_signal(sig: str, names: tuple[str, ...]) -> None:
 def node_ping(name: str, count: int) -> None:
     """Check that NAME answers on its XML-RPC API, and how fast."""
     uri_master = _master_uri()
-    name = _global(name)
+    name = graph_name(name)
     for i in range(count):
         uri, rtt = introspect.ping_node(uri_master, name)
         if rtt is None:
@@ -395,7 +268,7 @@ def node_loggers(name: str, logger: str | None, levels: bool) -> None:
     """Print the loggers of node NAME, one per line (as rosconsole list); with LOGGER, print
     that logger's level (as rosconsole get)."""
     uri_master = _master_uri()
-    name = _global(name)
+    name = graph_name(name)
     loggers = _node_loggers(uri_master, name)
     if logger is not None:
         table = dict(loggers)
@@ -418,7 +291,7 @@ def node_set_logger_level(name: str, logger: str, level: str) -> None:
     rosconsole set does."""
     from orchestra.node.msg import get_service_class
     uri_master = _master_uri()
-    name = _global(name)
+    name = graph_name(name)
     if logger not in dict(_node_loggers(uri_master, name)):
         raise OrchestraError(f"node {name} does not contain logger {logger}")
     cls = get_service_class("roscpp/SetLoggerLevel")
@@ -440,7 +313,7 @@ def topic() -> None:
 def topic_list(namespace: str | None, verbose: bool) -> None:
     """Print every topic with a publisher or a subscriber (in NAMESPACE, if given)."""
     state = introspect.system_state(_master_uri())
-    within = _in_namespace(_global(namespace)) if namespace else (lambda t: True)
+    within = _in_namespace(graph_name(namespace)) if namespace else (lambda t: True)
     if not verbose:
         for t in state.topics:
             if within(t):
@@ -467,7 +340,7 @@ def _in_namespace(name: str):
 @click.argument("name")
 def topic_type(name: str) -> None:
     """Print the message type of NAME."""
-    name = _global(name)
+    name = graph_name(name)
     state = introspect.system_state(_master_uri())
     if name not in state.types:
         raise OrchestraError(f"unknown topic {name} (nobody publishes it)")
@@ -489,7 +362,7 @@ def topic_find(type_name: str) -> None:
 @click.argument("name")
 def topic_info(name: str) -> None:
     """Type, publishers and subscribers of NAME."""
-    name = _global(name)
+    name = graph_name(name)
     uri = _master_uri()
     state = introspect.system_state(uri)
     if name not in state.publishers and name not in state.subscribers:
@@ -528,7 +401,7 @@ def topic_echo(name: str, count: int | None, noarr: bool) -> None:
     """Print each message on NAME as YAML followed by a '---' line."""
     from orchestra.node.decode import RawDecoder
     from orchestra.node.msg import to_yaml_text
-    name = _global(name)
+    name = graph_name(name)
     rospy = _start_cli_node()
     decode = RawDecoder()
     printed = 0
@@ -626,7 +499,7 @@ def topic_pub(name: str, type_name: str, values: tuple[str, ...], rate: float | 
 
     A time field given as 'now' is the current (wall) time, a Header given as 'auto' is one
     stamped now; both are evaluated once, at start, unless -s asks for each message."""
-    name = _global(name)
+    name = graph_name(name)
     cls = _message_class(type_name)
     value = _parse_yaml(values, type_name)
     msg = _fill(cls, value, type_name)
@@ -676,7 +549,7 @@ def _drain(pub, deadline: float) -> None:
               help="Exit after N reports (an orchestra extension).")
 def topic_hz(name: str, window: int | None, reports: int | None) -> None:
     """Print the publishing rate of NAME every second."""
-    name = _global(name)
+    name = graph_name(name)
     rospy = _start_cli_node()
     stamps: list[float] = []
     done = 0
@@ -738,14 +611,14 @@ def service_list() -> None:
 @click.argument("name")
 def service_type(name: str) -> None:
     """Print the service type of NAME (asked from the service itself)."""
-    click.echo(introspect.service_header(_master_uri(), _global(name)).get("type", ""))
+    click.echo(introspect.service_header(_master_uri(), graph_name(name)).get("type", ""))
 
 
 @service.command("uri")
 @click.argument("name")
 def service_uri(name: str) -> None:
     """Print the rosrpc:// URI of NAME."""
-    click.echo(introspect.service_uri(_master_uri(), _global(name)))
+    click.echo(introspect.service_uri(_master_uri(), graph_name(name)))
 
 
 @service.command("args")
@@ -753,7 +626,7 @@ def service_uri(name: str) -> None:
 def service_args(name: str) -> None:
     """Print the request field names of NAME."""
     from orchestra.node.msg import MessageNotFound, get_service_class
-    srv_type = introspect.service_header(_master_uri(), _global(name)).get("type", "")
+    srv_type = introspect.service_header(_master_uri(), graph_name(name)).get("type", "")
     try:
         click.echo(" ".join(get_service_class(srv_type)._request_class._fields))
     except (MessageNotFound, ROSException) as exc:
@@ -766,7 +639,7 @@ def service_info(name: str) -> None:
     """Node, URI, type and request fields of NAME."""
     from orchestra.node.msg import MessageNotFound, get_service_class
     uri_master = _master_uri()
-    name = _global(name)
+    name = graph_name(name)
     header = introspect.service_header(uri_master, name)
     state = introspect.system_state(uri_master)
     providers = state.services.get(name, [])
@@ -787,7 +660,7 @@ def service_call(name: str, values: tuple[str, ...]) -> None:
     """Call NAME with a request built from YAML VALUES; print the response as YAML."""
     from orchestra.node.msg import MessageNotFound, get_service_class, to_yaml_text
     uri_master = _master_uri()
-    name = _global(name)
+    name = graph_name(name)
     header = introspect.service_header(uri_master, name)
     srv_type = header.get("type", "")
     try:

@@ -1,16 +1,15 @@
-"""``orchestra pkg`` (rospack), ``orchestra run`` (rosrun) and ``orchestra create-pkg``.
+"""``orchestra pkg`` (rospack) and ``orchestra create-pkg`` (catkin_create_pkg).
 
-Thin wrappers: every decision is made in the library modules next to this one.
+Thin wrappers: every decision is made in the library modules next to this one. (``orchestra
+run``, rosrun, gives the executable the ROS 1 layer's environment, so it lives a layer up,
+in ros1/cli.py.)
 """
 from __future__ import annotations
 
 import os
 import shlex
-import sys
 
 import click
-
-from orchestra.errors import OrchestraError
 
 
 @click.group()
@@ -145,35 +144,6 @@ def deps_cmd(name: str, direct: bool, kinds: tuple[str, ...], reverse: bool, mis
             names = [n for n in names if n in absent]
     for dep in names:
         click.echo(dep)
-
-
-@click.command(context_settings={"ignore_unknown_options": True,
-                                 "allow_interspersed_args": False})
-@click.option("--prefix", default=None, metavar="CMD",
-              help="Command to run the executable under, e.g. 'gdb -ex run --args'.")
-@click.argument("package")
-@click.argument("exe")
-@click.argument("args", nargs=-1, type=click.UNPROCESSED)
-def run(prefix: str | None, package: str, exe: str, args: tuple[str, ...]) -> None:
-    """Run executable EXE of PACKAGE with ARGS (like rosrun).
-
-    The executable replaces this process, so signals and the exit code are its own. A Python
-    node gets orchestra's ROS 1 layer (rospy, <pkg>.msg...) unless a real rospy is
-    importable, as under ``orchestra launch`` (docs/rospy-layer.md).
-    """
-    from orchestra.packages.executables import find_executable
-    from orchestra.ros1.activation import layer_env
-
-    path = find_executable(package, exe)
-    argv = (shlex.split(prefix) if prefix else []) + [path, *args]
-    sys.stdout.flush()
-    sys.stderr.flush()
-    env = dict(os.environ)
-    env.update(layer_env(env))
-    try:
-        os.execvpe(argv[0], argv, env)
-    except OSError as exc:
-        raise OrchestraError(f"cannot execute {argv[0]}: {exc.strerror}") from None
 
 
 CREATE_HELP = """Create catkin package NAME depending on DEPS (like catkin_create_pkg).
