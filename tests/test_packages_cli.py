@@ -286,3 +286,20 @@ def test_misspelled_package_and_launch_file_get_a_did_you_mean():
     assert pkg.returncode == 2 and pkg.stderr.rstrip().endswith("(did you mean learning_tf?)")
     file = launch("learning_tf", "start_tf_dem.launch")
     assert file.returncode == 2 and "(did you mean start_tf_demo.launch" in file.stderr
+
+
+def test_a_package_without_a_launch_file_or_an_unlike_name_lists_its_launch_files():
+    import subprocess
+    import sys
+
+    def launch(*words: str) -> subprocess.CompletedProcess:
+        return subprocess.run([sys.executable, "-m", "orchestra", "launch", *words, "--nodes"],
+                              capture_output=True, text=True, timeout=60)
+
+    listing = "(its launch files: start_tf_demo.launch, start_tf_demo_py.launch)"
+    alone = launch("learning_tf")
+    assert alone.returncode == 2
+    assert alone.stderr == ("orchestra: error: [learning_tf] is a package, not a launch file: "
+                            f"name a launch file after it {listing}\n")
+    unlike = launch("learning_tf", "robot.launch")
+    assert unlike.returncode == 2 and unlike.stderr.rstrip().endswith(listing)

@@ -29,15 +29,43 @@ def find_in_package(package: str, filename: str) -> str:
     if not matches:
         from orchestra.suggest import did_you_mean
 
-        launch_files = [f for _, _, files in os.walk(root, followlinks=True) for f in files
-                        if f.endswith((".launch", ".xml", ".yaml")) and f != "package.xml"]
+        launch_files = package_launch_files(root)
+        hint = did_you_mean(base, launch_files) or _listing(package, launch_files)
         raise OrchestraError(f"[{filename}] is neither a launch file in package [{package}] "
-                             f"nor a launch file name{did_you_mean(base, launch_files)}")
+                             f"nor a launch file name{hint}")
     if len(matches) > 1:
         listing = "".join(f"\n  {m}" for m in matches)
         raise OrchestraError(f"multiple files named [{filename}] in package [{package}]:"
                              f"{listing}\nname one by its path")
     return matches[0]
+
+
+def package_launch_files(root: str) -> list[str]:
+    """The names of the launch files anywhere below a package's directory, sorted."""
+    return sorted({f for _, _, files in os.walk(root, followlinks=True) for f in files
+                   if f.endswith((".launch", ".xml", ".yaml")) and f != "package.xml"})
+
+
+def _listing(package: str, launch_files: list[str]) -> str:
+    """`` (its launch files: a.launch, b.launch)``: what the user can name instead."""
+    if not launch_files:
+        return f" (package [{package}] has no launch files)"
+    more = f", ... ({len(launch_files)} in all)" if len(launch_files) > 8 else ""
+    return f" (its launch files: {', '.join(launch_files[:8])}{more})"
+
+
+def _package_without_file(word: str) -> None:
+    """``orchestra launch PKG`` with no FILE: say so and list PKG's launch files, instead
+    of reporting a missing file named like the package."""
+    from orchestra.packages import find_package
+    if os.sep in word or os.path.exists(word):
+        return
+    try:
+        root = find_package(word)
+    except OrchestraError:
+        return
+    raise OrchestraError(f"[{word}] is a package, not a launch file: name a launch file "
+                         f"after it{_listing(word, package_launch_files(root))}")
 
 
 def split_words(words: tuple[str, ...]) -> tuple[list[str], dict[str, str]]:
@@ -48,6 +76,8 @@ def split_words(words: tuple[str, ...]) -> tuple[list[str], dict[str, str]]:
     if not positional:
         raise OrchestraError("give a launch file: [PKG] FILE [name:=value ...]")
     first = positional[0]
+    if len(positional) == 1 and not first.endswith((".launch", ".xml", ".yaml", ".yml")):
+        _package_without_file(first)
     if first == "-" or os.path.isfile(first) or len(positional) != 2 \
             or first.endswith((".launch", ".xml", ".yaml", ".yml")):
         files = positional
