@@ -358,6 +358,22 @@ def test_service_calls_cross_between_rospy_and_orchestra(side, direction):
     assert empty.expect(lambda d: "results" in d, timeout=15)["results"] == [{"ok": {}}] * 2
 
 
+@pytest.mark.parametrize("direction", ["rospy_serves", "orchestra_serves"])
+def test_a_handler_returning_none_is_the_same_error_for_the_caller_as_in_rospy(side, direction):
+    serve, call = ((side.rospy, side.orch) if direction == "rospy_serves"
+                   else (side.orch, side.rospy))
+    serve("--name", "server", "serve", "none", "std_srvs/Trigger")
+    caller = call("--name", "caller", "call", "/none", "std_srvs/Trigger", "{}", "{}")
+    # the same words whichever side serves (Debian's rospy client shows them as a bytes
+    # repr); both calls: the server keeps serving
+    results = caller.expect(lambda d: "results" in d, timeout=15)["results"]
+    assert len(results) == 2
+    for result in results:
+        assert result["error"].startswith("service [/none] responded with an error: ")
+        assert "service cannot process request: service handler returned None" in \
+            result["error"]
+
+
 # --- 4. the tools crossed -------------------------------------------------------------------
 
 def test_real_rostopic_lists_inspects_echoes_and_publishes_with_orchestra_nodes(side):

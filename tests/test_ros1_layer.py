@@ -223,6 +223,7 @@ EXPECTED_BEHAVIOUR = [
     {"early_topic": "after init"},
     {"greeting": "welcome 1"},
     {"service_error": True, "error_handler": ["no True"]},
+    {"none_handler": True, "error_handler": []},
     {"master_pid_code": 1},
     {"names": ["/behaviours", "/", "/x", "/behaviours/y", "/behaviours"]},
     {"myargv": ["script", "arg"]},

@@ -35,11 +35,14 @@ log = logging.getLogger(__name__)
 
 
 def _as_response(value: Any, response_class: type[Message]) -> Message:
-    """What a handler returned, as a response message (rospy accepts these shapes too)."""
+    """What a handler returned, as a response message (rospy accepts these shapes too).
+
+    ``None`` is no answer, as in rospy: a handler that cannot process a request may return
+    it, and the caller gets an error rather than a response that looks like a success."""
     if isinstance(value, response_class):
         return value
     if value is None:
-        return response_class()
+        raise ServiceException("service handler returned None")
     if isinstance(value, Message):
         raise ServiceException(f"handler returned a {value._type}, expected "
                                f"{response_class._type}")
@@ -119,6 +122,11 @@ class ServiceServer:
             request = cls._request_class.deserialize_bytes(data)
             response = _as_response(self.handler(request), cls._response_class)
             body = response.serialize_bytes()
+        except ServiceException as exc:  # no (usable) response: rospy's words for it
+            log.error("service %s: cannot process request from %s: %s", self.name, caller, exc)
+            tcpros.send_service_response(sock, False,
+                                         f"service cannot process request: {exc}".encode())
+            return
         except Exception as exc:  # the handler's error goes back to the caller
             log.error("service %s: error processing request from %s: %s", self.name, caller, exc)
             tcpros.send_service_response(sock, False,

@@ -13,6 +13,7 @@ from roslib.message import get_message_class, get_service_class
 
 String = get_message_class("std_msgs/String")
 SetBool = get_service_class("std_srvs/SetBool")
+Trigger = get_service_class("std_srvs/Trigger")
 
 
 def emit(**kv):
@@ -64,6 +65,18 @@ try:
     emit(service_error=None)
 except rospy.ServiceException as exc:
     emit(service_error="no True" in str(exc), error_handler=errors)
+
+# a handler that returns None gives no answer: the caller gets an error (error_handler is
+# only for exceptions the handler raised)
+none_errors = []
+rospy.Service("~none", Trigger, lambda req: None,
+              error_handler=lambda exc, exc_type, value, tb: none_errors.append(str(exc)))
+rospy.wait_for_service("~none", timeout=10)
+try:
+    rospy.ServiceProxy("~none", Trigger)()
+    emit(none_handler=None)
+except rospy.ServiceException as exc:
+    emit(none_handler="service handler returned None" in str(exc), error_handler=none_errors)
 
 for i in range(3):
     rospy.logdebug_once("debug once %d", i)

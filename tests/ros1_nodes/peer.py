@@ -9,8 +9,9 @@ one way and fails the other points at orchestra, not at a difference in the test
     peer.py [--orchestra] [--name N] MODE ...
     MODE pub TOPIC TYPE YAML [--latch] [--rate HZ] [--count N]
          sub TOPIC TYPE
-         serve SERVICE TYPE          (std_srvs/Empty or std_srvs/SetBool; SetBool data=false
-                                      makes the handler raise)
+         serve SERVICE TYPE          (std_srvs/Empty, std_srvs/SetBool or std_srvs/Trigger;
+                                      SetBool data=false makes the handler raise, Trigger's
+                                      handler returns None)
          call SERVICE TYPE YAML... [--persistent]   one call per YAML word
          params                       report ~private / relative / searched params
          watch KEY                    print get_param_cached(KEY) each time it changes
@@ -119,6 +120,8 @@ def run_serve(service, type_name):
             if not req.data:
                 raise ValueError(f"refused by {impl}")
             return cls._response_class(success=True, message=f"{impl} call {len(calls)}")
+        if type_name.endswith("Trigger"):
+            return None  # no answer: rospy reports an error to the caller
         return cls._response_class()
 
     rospy.init_node(opts.name, anonymous=opts.anonymous)
