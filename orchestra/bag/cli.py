@@ -216,12 +216,12 @@ def record(topics: tuple[str, ...], all_: bool, regex: str | None, exclude: str 
         split_size=int(size * 1024 * 1024) if split and size else None,
         split_duration=seconds if split else None, compression=compression or "none",
         buffsize=buffsize * 1024 * 1024, chunksize=chunksize * 1024, limit=limit)
-    from orchestra.node.cli import _master_uri, _require_master
+    from orchestra.node.tool import master_uri, require_master
     try:
         recorder = Recorder(opts)
     except RecordError as exc:
         raise BagError(str(exc)) from None
-    _require_master(_master_uri())
+    require_master(master_uri())
     stop = _stop_on_signals(recorder.stopping)
     try:
         recorder.start()
@@ -296,7 +296,7 @@ def play(files: tuple[str, ...], rate: float, start: float, duration: float | No
 
     On a terminal: space pauses and resumes, s publishes one message while paused."""
     from orchestra.bag.play import Player, PlayOptions
-    from orchestra.node.cli import _master_uri, _require_master
+    from orchestra.node.tool import master_uri, require_master
     files, extra = _split_topics(files, topics)
     opts = PlayOptions(rate=rate, start=start, duration=duration, loop=loop, clock=clock,
                        hz=hz, topics=extra or None, pause=pause, delay=delay,
@@ -314,7 +314,7 @@ def play(files: tuple[str, ...], rate: float, start: float, duration: float | No
         raise
     player = Player(readers, opts)
     try:
-        _require_master(_master_uri())
+        require_master(master_uri())
     except BaseException:
         player.close()
         raise
@@ -342,8 +342,8 @@ def play(files: tuple[str, ...], rate: float, start: float, duration: float | No
         player.close()
         if not quiet and sys.stdout.isatty():
             click.echo("\nDone.")
-        from orchestra.node.cli import _stop_cli_node
-        _stop_cli_node("bag play done")
+        from orchestra.node.tool import stop_cli_node
+        stop_cli_node("bag play done")
     if player.error is not None:
         raise BagError(f"damaged bag: {player.error}; `orchestra bag reindex` may help")
 

@@ -19,25 +19,13 @@ from orchestra.errors import OrchestraError
 from orchestra.node import introspect
 from orchestra.node.exceptions import ROSException
 from orchestra.node.loggers import LEVEL_NAMES
-from orchestra.rpc import MasterUnreachable, master_is_up, master_uri_from_env
-
-CLI_NODE = "orchestra_cli"
+from orchestra.node.tool import master_uri, start_cli_node, stop_cli_node
 
 
 class CommandFailed(OrchestraError):
     """The command ran but what it asked for failed (a service error, ...): exit 1."""
 
     exit_code = 1
-
-
-def _master_uri() -> str:
-    return master_uri_from_env()
-
-
-def _require_master(uri: str) -> None:
-    if not master_is_up(uri, timeout=2.0):
-        raise MasterUnreachable(f"cannot contact the master at {uri} (is it running? "
-                                "check ROS_MASTER_URI)")
 
 
 def graph_name(name: str) -> str:
@@ -80,22 +68,6 @@ def _message_class(type_name: str):
         raise OrchestraError(str(exc)) from None
 
 
-def _start_cli_node():
-    """This process as an anonymous node (as rostopic does), without signal handlers, on
-    wall time even under /use_sim_time (rostopic pub's default), so ``topic pub -r`` can be
-    the /clock publisher itself."""
-    import orchestra.node as rospy
-    _require_master(_master_uri())
-    rospy.init_node(CLI_NODE, argv=[], anonymous=True, disable_signals=True,
-                    disable_rosout=True, disable_rostime=True)
-    return rospy
-
-
-def _stop_cli_node(reason: str) -> None:
-    from orchestra.node import runtime
-    runtime.reset(reason)
-
-
 # --- node -------------------------------------------------------------------------------------
 
 @click.group()
@@ -107,7 +79,7 @@ def node() -> None:
 @node.command("list")
 def node_list() -> None:
     """Print every node known to the master."""
-    for name in introspect.system_state(_master_uri()).nodes:
+    for name in introspect.system_state(master_uri()).nodes:
         click.echo(name)
 
 
@@ -119,7 +91,7 @@ def _bullets(items: list[str]) -> str:
 @click.argument("name")
 def node_info(name: str) -> None:
     """Publications, subscriptions, services and connections of NAME."""
-    uri_master = _master_uri()
+    uri_master = master_uri()
     name = graph_name(name)
     state = introspect.system_state(uri_master)
     uri = introspect.lookup_node(uri_master, name)
@@ -183,7 +155,7 @@ def _peer(master_uri: str, state, topic: str, dest: str, cache: dict) -> str:
 @click.option("-a", "--all", "kill_all", is_flag=True, help="Kill every node.")
 def node_kill(names: tuple[str, ...], kill_all: bool) -> None:
     """Ask NAMES to shut down (through their slave API, as rosnode kill does)."""
-    uri = _master_uri()
+    uri = master_uri()
     targets = introspect.system_state(uri).nodes if kill_all else [graph_name(n) for n in names]
     if not targets:
         raise OrchestraError("give the node names to kill, or --all")
@@ -206,7 +178,7 @@ def node_kill(names: tuple[str, ...], kill_all: bool) -> None:
               help="Number of pings.")
 def node_ping(name: str, count: int) -> None:
     """Check that NAME answers on its XML-RPC API, and how fast."""
-    uri_master = _master_uri()
+    uri_master = master_uri()
     name = graph_name(name)
     for i in range(count):
         uri, rtt = introspect.ping_node(uri_master, name)
@@ -221,7 +193,7 @@ def node_ping(name: str, count: int) -> None:
 @click.option("-y", "--yes", is_flag=True, help="Purge without asking.")
 def node_cleanup(yes: bool) -> None:
     """Unregister nodes that died without unregistering (their API no longer answers)."""
-    uri = _master_uri()
+    uri = master_uri()
     state = introspect.system_state(uri)
     dead = introspect.unreachable_nodes(uri, state)
     if not dead:
@@ -267,7 +239,7 @@ def _logger_service(uri_master: str, node_name: str, suffix: str, cls) -> str:
 def node_loggers(name: str, logger: str | None, levels: bool) -> None:
     """Print the loggers of node NAME, one per line (as rosconsole list); with LOGGER, print
     that logger's level (as rosconsole get)."""
-    uri_master = _master_uri()
+    uri_master = master_uri()
     name = graph_name(name)
     loggers = _node_loggers(uri_master, name)
     if logger is not None:
@@ -290,7 +262,7 @@ def node_set_logger_level(name: str, logger: str, level: str) -> None:
     """Set LOGGER of node NAME to LEVEL (debug, info, warn, error or fatal) at once, as
     rosconsole set does."""
     from orchestra.node.msg import get_service_class
-    uri_master = _master_uri()
+    uri_master = master_uri()
     name = graph_name(name)
     if logger not in dict(_node_loggers(uri_master, name)):
         raise OrchestraError(f"node {name} does not contain logger {logger}")
@@ -312,7 +284,7 @@ def topic() -> None:
 @click.option("-v", "--verbose", is_flag=True, help="Group by publishers and subscribers.")
 def topic_list(namespace: str | None, verbose: bool) -> None:
     """Print every topic with a publisher or a subscriber (in NAMESPACE, if given)."""
-    state = introspect.system_state(_master_uri())
+    state = introspect.system_state(master_uri())
     within = _in_namespace(graph_name(namespace)) if namespace else (lambda t: True)
     if not verbose:
         for t in state.topics:
@@ -341,7 +313,7 @@ def _in_namespace(name: str):
 def topic_type(name: str) -> None:
     """Print the message type of NAME."""
     name = graph_name(name)
-    state = introspect.system_state(_master_uri())
+    state = introspect.system_state(master_uri())
     if name not in state.types:
         raise OrchestraError(f"unknown topic {name} (nobody publishes it)")
     click.echo(state.types[name])
@@ -353,7 +325,7 @@ def topic_find(type_name: str) -> None:
     """Print the published topics of message type TYPE."""
     from orchestra.node.msg import normalise_type
     wanted = normalise_type(type_name)
-    for name, type_ in sorted(introspect.system_state(_master_uri()).types.items()):
+    for name, type_ in sorted(introspect.system_state(master_uri()).types.items()):
         if type_ == wanted:
             click.echo(name)
 
@@ -363,7 +335,7 @@ def topic_find(type_name: str) -> None:
 def topic_info(name: str) -> None:
     """Type, publishers and subscribers of NAME."""
     name = graph_name(name)
-    uri = _master_uri()
+    uri = master_uri()
     state = introspect.system_state(uri)
     if name not in state.publishers and name not in state.subscribers:
         raise OrchestraError(f"unknown topic {name}")
@@ -402,11 +374,11 @@ def topic_echo(name: str, count: int | None, noarr: bool) -> None:
     from orchestra.node.decode import RawDecoder
     from orchestra.node.msg import to_yaml_text
     name = graph_name(name)
-    rospy = _start_cli_node()
+    rospy = start_cli_node()
     decode = RawDecoder()
     printed = 0
     try:
-        state = introspect.system_state(_master_uri())
+        state = introspect.system_state(master_uri())
         topic, fields = split_field_path(name, state.topics)
         if topic not in state.publishers:
             click.echo(f"WARNING: topic [{topic}] does not appear to be published yet", err=True)
@@ -429,7 +401,7 @@ def topic_echo(name: str, count: int | None, noarr: bool) -> None:
     except KeyboardInterrupt:
         pass
     finally:
-        _stop_cli_node("topic echo done")
+        stop_cli_node("topic echo done")
 
 
 def _wait_for_topic(path: str) -> tuple[str, list[str]]:
@@ -437,7 +409,7 @@ def _wait_for_topic(path: str) -> tuple[str, list[str]]:
     waits for the topic's type: only then can ``/cmd_vel/linear/x`` be split into topic
     and fields."""
     while True:
-        topics = introspect.system_state(_master_uri()).topics
+        topics = introspect.system_state(master_uri()).topics
         topic, fields = split_field_path(path, topics)
         if topic in topics:
             return topic, fields
@@ -505,12 +477,12 @@ def topic_pub(name: str, type_name: str, values: tuple[str, ...], rate: float | 
     msg = _fill(cls, value, type_name)
     if rate is not None and rate <= 0:
         raise OrchestraError("--rate must be positive")
-    rospy = _start_cli_node()
+    rospy = start_cli_node()
     try:
         latched = latch or rate is None
         pub = rospy.Publisher(name, cls, queue_size=100, latch=latched)
         if once:
-            expected = len(introspect.system_state(_master_uri()).subscribers.get(name, []))
+            expected = len(introspect.system_state(master_uri()).subscribers.get(name, []))
             click.echo(f"publishing and latching message for up to {wait_time:g} seconds "
                        f"({expected} subscriber{'s' if expected != 1 else ''})")
             pub.publish(msg)
@@ -532,7 +504,7 @@ def topic_pub(name: str, type_name: str, values: tuple[str, ...], rate: float | 
     except (KeyboardInterrupt, rospy.ROSInterruptException):
         pass
     finally:
-        _stop_cli_node("topic pub done")
+        stop_cli_node("topic pub done")
 
 
 def _drain(pub, deadline: float) -> None:
@@ -550,7 +522,7 @@ def _drain(pub, deadline: float) -> None:
 def topic_hz(name: str, window: int | None, reports: int | None) -> None:
     """Print the publishing rate of NAME every second."""
     name = graph_name(name)
-    rospy = _start_cli_node()
+    rospy = start_cli_node()
     stamps: list[float] = []
     done = 0
     try:
@@ -580,7 +552,7 @@ def topic_hz(name: str, window: int | None, reports: int | None) -> None:
     except KeyboardInterrupt:
         pass
     finally:
-        _stop_cli_node("topic hz done")
+        stop_cli_node("topic hz done")
 
 
 def hz_report(stamps: list[float]) -> str:
@@ -603,7 +575,7 @@ def service() -> None:
 @service.command("list")
 def service_list() -> None:
     """Print every service known to the master."""
-    for name in sorted(introspect.system_state(_master_uri()).services):
+    for name in sorted(introspect.system_state(master_uri()).services):
         click.echo(name)
 
 
@@ -611,14 +583,14 @@ def service_list() -> None:
 @click.argument("name")
 def service_type(name: str) -> None:
     """Print the service type of NAME (asked from the service itself)."""
-    click.echo(introspect.service_header(_master_uri(), graph_name(name)).get("type", ""))
+    click.echo(introspect.service_header(master_uri(), graph_name(name)).get("type", ""))
 
 
 @service.command("uri")
 @click.argument("name")
 def service_uri(name: str) -> None:
     """Print the rosrpc:// URI of NAME."""
-    click.echo(introspect.service_uri(_master_uri(), graph_name(name)))
+    click.echo(introspect.service_uri(master_uri(), graph_name(name)))
 
 
 @service.command("args")
@@ -626,7 +598,7 @@ def service_uri(name: str) -> None:
 def service_args(name: str) -> None:
     """Print the request field names of NAME."""
     from orchestra.node.msg import MessageNotFound, get_service_class
-    srv_type = introspect.service_header(_master_uri(), graph_name(name)).get("type", "")
+    srv_type = introspect.service_header(master_uri(), graph_name(name)).get("type", "")
     try:
         click.echo(" ".join(get_service_class(srv_type)._request_class._fields))
     except (MessageNotFound, ROSException) as exc:
@@ -638,7 +610,7 @@ def service_args(name: str) -> None:
 def service_info(name: str) -> None:
     """Node, URI, type and request fields of NAME."""
     from orchestra.node.msg import MessageNotFound, get_service_class
-    uri_master = _master_uri()
+    uri_master = master_uri()
     name = graph_name(name)
     header = introspect.service_header(uri_master, name)
     state = introspect.system_state(uri_master)
@@ -659,7 +631,7 @@ def service_info(name: str) -> None:
 def service_call(name: str, values: tuple[str, ...]) -> None:
     """Call NAME with a request built from YAML VALUES; print the response as YAML."""
     from orchestra.node.msg import MessageNotFound, get_service_class, to_yaml_text
-    uri_master = _master_uri()
+    uri_master = master_uri()
     name = graph_name(name)
     header = introspect.service_header(uri_master, name)
     srv_type = header.get("type", "")
@@ -709,7 +681,7 @@ def _call_service(uri_master: str, name: str, cls, request):
 def graph(out: str | None, show_all: bool) -> None:
     """Draw the running nodes and the topics between them."""
     from orchestra.node import graph as graphs
-    g = graphs.build_graph(introspect.system_state(_master_uri()), show_all=show_all)
+    g = graphs.build_graph(introspect.system_state(master_uri()), show_all=show_all)
     if out is None:
         click.echo(graphs.to_dot(g), nl=False)
         return

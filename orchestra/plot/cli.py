@@ -123,11 +123,11 @@ def plot(specs: tuple[str, ...], bag_path: str | None, out: str | None, duration
 
 def _plot_live(specs: tuple[str, ...], out: str | None, duration: float, title: str) -> None:
     from orchestra.node import introspect
-    from orchestra.node.cli import _master_uri, _start_cli_node, _stop_cli_node
+    from orchestra.node.tool import master_uri, start_cli_node, stop_cli_node
     from orchestra.plot import figure
-    _start_cli_node()
+    start_cli_node()
     try:
-        state = introspect.system_state(_master_uri())
+        state = introspect.system_state(master_uri())
         series = _parse(specs, sorted(state.topics))
         source = LiveSource(series)
         if out is None:
@@ -144,4 +144,4 @@ def _plot_live(specs: tuple[str, ...], out: str | None, duration: float, title: 
                 click.echo(f"warning: no data for {s.label} in {duration:g} s", err=True)
         figure.save(series, out, title)
     finally:
-        _stop_cli_node("plot done")
+        stop_cli_node("plot done")
