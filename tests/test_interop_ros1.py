@@ -19,14 +19,13 @@ import socket
 import subprocess
 import sys
 import time
-import xmlrpc.client
 from pathlib import Path
 
 import pytest
 import yaml
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
-from harness import ROS_PYTHON, NodeProcess, ProcessGroup, wait_for  # noqa: E402
+from harness import ROS_PYTHON, NodeProcess, OneShotProxy, ProcessGroup, wait_for  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 PEER = HERE / "ros1_nodes" / "peer.py"
@@ -116,7 +115,7 @@ def real_master(tmp_path):
                             env=_ros_env({"ROS_HOME": str(tmp_path / "ros_home"),
                                           "ROS_MASTER_URI": uri}),
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    proxy = xmlrpc.client.ServerProxy(uri)
+    proxy = OneShotProxy(uri)
 
     def up():
         try:
@@ -154,7 +153,7 @@ def test_rospy_node_registers_and_lookup_node_returns_its_slave_api(side):
     talker.ready()
     code, _, uri = side.master().lookupNode("/probe", "/talker")
     assert code == 1
-    assert xmlrpc.client.ServerProxy(uri).getPid("/probe")[2] == talker.proc.pid
+    assert OneShotProxy(uri).getPid("/probe")[2] == talker.proc.pid
     _, _, state = side.master().getSystemState("/probe")
     assert ["/chatter", ["/talker"]] in state[0]
     _, _, topics = side.master().getTopicTypes("/probe")
@@ -186,7 +185,7 @@ def test_a_node_registering_a_taken_name_shuts_the_old_one_down(masters, request
     group.rospy("--name", "twin", "pub", "c", "std_msgs/String", "data: x").ready()
     old_orch.wait(10)   # ... and a rospy node took it back
     _, _, uri = group.master().lookupNode("/probe", "/twin")
-    assert xmlrpc.client.ServerProxy(uri).getPid("/probe")[2] == group.procs[-1].proc.pid
+    assert OneShotProxy(uri).getPid("/probe")[2] == group.procs[-1].proc.pid
 
 
 def _seed_params(params) -> None:
@@ -324,7 +323,7 @@ def test_md5_mismatch_is_refused_and_both_nodes_keep_working(side, direction):
                          for line in ours.stderr_lines), timeout=5)
     # the refused subscriber's node still answers its slave API
     _, _, uri = side.master().lookupNode("/probe", "/wrong")
-    assert xmlrpc.client.ServerProxy(uri).getPid("/probe")[0] == 1
+    assert OneShotProxy(uri).getPid("/probe")[0] == 1
 
 
 def _drain(proc: NodeProcess) -> list[dict]:
@@ -677,7 +676,7 @@ def test_orchestra_launch_waits_for_an_external_rosmaster_and_uploads_params(tmp
         report = _wait_for_file(out, ours, log)
         assert report["private"] == {"rate": 5.5, "label": "007",
                                      "config": {"a": 1, "b": ["x", "y"]}}
-        real = xmlrpc.client.ServerProxy(uri)
+        real = OneShotProxy(uri)
         assert real.getParam("/probe", "/robot/reporter/rate")[2] == 5.5
         assert real.getParam("/probe", "/interop/global")[2] == "g"
         assert real.getParam("/probe", "/run_id")[0] == 1
@@ -721,7 +720,7 @@ def test_real_roslaunch_runs_a_launch_file_against_orchestra_core(tmp_path):
         assert report["private"] == {"rate": 5.5, "label": "007",
                                      "config": {"a": 1, "b": ["x", "y"]}}
         assert report["published"] == ["/robot/speech", "/rosout"]
-        master = xmlrpc.client.ServerProxy(uri)
+        master = OneShotProxy(uri)
         # roslaunch found orchestra core's /run_id and registered its own server node
         run_id = master.getParam("/probe", "/run_id")[2]
         assert run_id in log.read_text()

@@ -22,13 +22,12 @@ import signal
 import socket
 import subprocess
 import sys
-import xmlrpc.client
 from pathlib import Path
 
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
-from harness import ROS_PYTHON, NodeProcess, ProcessGroup, wait_for  # noqa: E402
+from harness import ROS_PYTHON, NodeProcess, OneShotProxy, ProcessGroup, wait_for  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
@@ -187,7 +186,7 @@ def test_orchestra_messages_cross_a_roscpp_relay_intact(graph):
     assert pubs["/in1"] == {"/pub1"} and subscribed["/out1"] == {"/sub1"}
     # the roscpp node's slave API, found through orchestra's master
     uri = graph.master().lookupNode("/probe", "/relay0")[2]
-    assert xmlrpc.client.ServerProxy(uri).getPid("/probe")[2] == relays["std_msgs/String"].proc.pid
+    assert OneShotProxy(uri).getPid("/probe")[2] == relays["std_msgs/String"].proc.pid
 
 
 def test_latched_orchestra_topic_stays_latched_through_a_roscpp_relay(graph):
@@ -421,7 +420,7 @@ def test_orchestra_launch_runs_debian_topic_tools_relay_and_cpp_rosout(tmp_path,
         master = group.master()
         assert master.getParam("/probe", "/robot/relay/lazy")[2] is False
         for node, exe in (("/robot/relay", RELAY), ("/rosout", ROSOUT)):
-            pid = xmlrpc.client.ServerProxy(
+            pid = OneShotProxy(
                 master.lookupNode("/probe", node)[2]).getPid("/probe")[2]
             assert os.readlink(f"/proc/{pid}/exe") == exe, node
         # the node is known once its first registration lands; its subscription may follow

@@ -54,7 +54,8 @@ class Slave:
 
 @pytest.fixture
 def m(master):
-    return xmlrpc.client.ServerProxy(master.uri)
+    with xmlrpc.client.ServerProxy(master.uri) as proxy:
+        yield proxy
 
 
 @pytest.fixture
@@ -84,11 +85,11 @@ def test_shutdown_is_idempotent_and_frees_the_port():
     handle = start_master(port=0)
     uri = handle.uri
     # a keep-alive connection open at shutdown time must not keep the server alive
-    proxy = xmlrpc.client.ServerProxy(uri)
-    proxy.getPid("/x")
-    handle.shutdown()
-    handle.shutdown()
-    assert not master_is_up(uri, timeout=0.5)
+    with xmlrpc.client.ServerProxy(uri) as proxy:
+        proxy.getPid("/x")
+        handle.shutdown()
+        handle.shutdown()
+        assert not master_is_up(uri, timeout=0.5)
     again = start_master(port=handle.port)  # the port is free again
     again.shutdown()
 
@@ -453,14 +454,14 @@ def test_concurrent_clients_see_consistent_state(master):
 
     def worker(n: int) -> None:
         try:
-            p = xmlrpc.client.ServerProxy(master.uri)
-            for i in range(50):
-                assert p.setParam(f"/w{n}", f"/w{n}/v", i)[0] == 1
-                assert p.getParam(f"/w{n}", f"/w{n}/v")[2] == i
-                p.registerPublisher(f"/w{n}", f"/t{i % 5}", "std_msgs/Int32",
-                                    f"http://127.0.0.1:{10000 + n}/")
-                p.getSystemState("/x")
-                p.getParam("/x", "/")
+            with xmlrpc.client.ServerProxy(master.uri) as p:
+                for i in range(50):
+                    assert p.setParam(f"/w{n}", f"/w{n}/v", i)[0] == 1
+                    assert p.getParam(f"/w{n}", f"/w{n}/v")[2] == i
+                    p.registerPublisher(f"/w{n}", f"/t{i % 5}", "std_msgs/Int32",
+                                        f"http://127.0.0.1:{10000 + n}/")
+                    p.getSystemState("/x")
+                    p.getParam("/x", "/")
         except BaseException as exc:  # noqa: BLE001 - reported below
             errors.append(exc)
     threads = [threading.Thread(target=worker, args=(n,)) for n in range(4)]
@@ -469,7 +470,8 @@ def test_concurrent_clients_see_consistent_state(master):
     for t in threads:
         t.join(30)
     assert errors == []
-    state = xmlrpc.client.ServerProxy(master.uri).getSystemState("/x")[2]
+    with xmlrpc.client.ServerProxy(master.uri) as proxy:
+        state = proxy.getSystemState("/x")[2]
     assert {topic: sorted(ids) for topic, ids in state[0]} == {
         f"/t{i}": ["/w0", "/w1", "/w2", "/w3"] for i in range(5)}
     assert {f"/w{n}/v" for n in range(4)} == set(master.params.names())

@@ -42,5 +42,6 @@ def test_params_waits_logging_and_shutdown_hooks_behave_like_rospy(nodes):
     log = rosout.expect(lambda d: d.get("msg", {}).get("name") == "/api", timeout=10)["msg"]
     assert log["msg"] == "hello log" and log["level"] == 2
     assert log["function"] == "<module>" and log["file"].endswith("api_node.py")
-    state = xmlrpc.client.ServerProxy(nodes.master_uri).getSystemState("/t")[2]
+    with xmlrpc.client.ServerProxy(nodes.master_uri) as proxy:
+        state = proxy.getSystemState("/t")[2]
     assert all("/api" not in names for group in state for _, names in group)

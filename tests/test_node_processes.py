@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
-from harness import Nodes, wait_for  # noqa: E402
+from harness import Nodes, OneShotProxy, wait_for  # noqa: E402
 
 from orchestra.master import start_master  # noqa: E402
 from orchestra.node import tcpros  # noqa: E402
@@ -20,7 +20,8 @@ pytestmark = pytest.mark.timeout(60)
 
 
 def system_state(master_uri: str):
-    return xmlrpc.client.ServerProxy(master_uri).getSystemState("/test")[2]
+    with xmlrpc.client.ServerProxy(master_uri) as master:
+        return master.getSystemState("/test")[2]
 
 
 def publishers_of(master_uri: str, topic: str) -> list[str]:
@@ -49,7 +50,7 @@ def _subscribers(nodes, topic: str) -> list[str]:
 def _live_connections(nodes, node: str, topic: str) -> list:
     """``node``'s connected inbound connections on ``topic`` (its slave API's bus info)."""
     _, _, uri = nodes.master().lookupNode("/test", node)
-    _, _, info = xmlrpc.client.ServerProxy(uri).getBusInfo("/test")
+    _, _, info = OneShotProxy(uri).getBusInfo("/test")
     return [c for c in info if c[4] == topic and c[2] == "i" and c[5]]
 
 
@@ -107,9 +108,9 @@ def test_subscriber_with_wrong_type_is_refused_and_publisher_keeps_running(nodes
 def test_wrong_md5_on_connect_gets_an_error_header(nodes):
     pub = nodes.start("pub.py", "typed2", "std_msgs/String", "data: x")
     pub.ready()
-    node_uri = wait_for(lambda: xmlrpc.client.ServerProxy(nodes.master_uri)
+    node_uri = wait_for(lambda: OneShotProxy(nodes.master_uri)
                         .lookupNode("/test", "/pub")[2])
-    code, _, proto = xmlrpc.client.ServerProxy(node_uri).requestTopic(
+    code, _, proto = OneShotProxy(node_uri).requestTopic(
         "/test", "/typed2", [["TCPROS"]])
     assert code == 1 and proto[0] == "TCPROS"
     with tcpros.connect(proto[1], proto[2]) as sock:
@@ -145,7 +146,7 @@ def test_subscriber_survives_dead_publisher_and_reconnects_when_it_returns(nodes
 
 
 def test_remaps_namespace_and_private_params_from_argv(nodes, master):
-    xmlrpc.client.ServerProxy(master.uri).setParam("/test", "/robot/shared", 3)
+    OneShotProxy(master.uri).setParam("/test", "/robot/shared", 3)
     proc = nodes.start("names_node.py", "extra", "chatter:=/remapped", "_rate:=5.5",
                        "_label:=[a, b]", "__ns:=/robot", "__name:=renamed")
     report = proc.expect(lambda d: "name" in d)
@@ -192,7 +193,7 @@ def test_service_calls_plain_persistent_probe_and_handler_error(nodes, master, m
 
     srv = nodes.start("adder.py", "add")
     assert srv.ready()["service"] == "/add"
-    m = xmlrpc.client.ServerProxy(master.uri)
+    m = OneShotProxy(master.uri)
     uri = m.lookupService("/test", "/add")[2]
     host, port = tcpros.parse_rosrpc_uri(uri)
     from orchestra.node.msg import Registry
@@ -257,8 +258,8 @@ def test_slave_api_reports_pid_publications_subscriptions_and_bus_info(nodes, ma
     sub = nodes.start("sub.py", "info_topic", "std_msgs/String", "--name", "infosub")
     sub.ready()
     sub.messages()
-    m = xmlrpc.client.ServerProxy(master.uri)
-    api = xmlrpc.client.ServerProxy(m.lookupNode("/test", "/infopub")[2])
+    m = OneShotProxy(master.uri)
+    api = OneShotProxy(m.lookupNode("/test", "/infopub")[2])
     assert api.getPid("/test") == [1, "", pub.proc.pid]
     assert ["/info_topic", "std_msgs/String"] in api.getPublications("/test")[2]
     assert api.getMasterUri("/test")[2] == master.uri
@@ -266,7 +267,7 @@ def test_slave_api_reports_pid_publications_subscriptions_and_bus_info(nodes, ma
     assert any(row[1] == "/infosub" and row[2] == "o" and row[4] == "/info_topic" for row in info)
     stats = api.getBusStats("/test")[2]
     assert any(row[0] == "/info_topic" and row[1] > 0 for row in stats[0])
-    sub_api = xmlrpc.client.ServerProxy(m.lookupNode("/test", "/infosub")[2])
+    sub_api = OneShotProxy(m.lookupNode("/test", "/infosub")[2])
     assert sub_api.getSubscriptions("/test")[2] == [["/info_topic", "std_msgs/String"]]
     assert sub_api.requestTopic("/test", "/nope", [["TCPROS"]])[0] == -1
     # publisherUpdate is idempotent: repeating the current list changes nothing
@@ -328,8 +329,8 @@ def test_slow_subscriber_with_queue_size_one_skips_to_the_newest_message(nodes):
 def test_garbage_and_unknown_requests_on_the_tcpros_port_do_not_hurt_the_node(nodes):
     pub = nodes.start("pub.py", "sturdy", "std_msgs/String", "data: ok", "--name", "sturdy")
     pub.ready()
-    master = xmlrpc.client.ServerProxy(nodes.master_uri)
-    api = xmlrpc.client.ServerProxy(wait_for(lambda: master.lookupNode("/t", "/sturdy")[2]))
+    master = OneShotProxy(nodes.master_uri)
+    api = OneShotProxy(wait_for(lambda: master.lookupNode("/t", "/sturdy")[2]))
     _, _, (_, host, port) = api.requestTopic("/t", "/sturdy", [["TCPROS"]])
     with socket.create_connection((host, port)) as sock:  # absurd header length
         sock.sendall(b"\xff\xff\xff\x7f garbage")

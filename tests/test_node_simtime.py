@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import functools
 import os
-import queue
 import signal
 import subprocess
 import sys
@@ -43,14 +42,7 @@ class Driven(NodeProcess):
     """A harness NodeProcess with a stdin pipe: ``send`` writes one command line."""
 
     def __init__(self, argv: list[str], env: dict[str, str]):
-        self.argv = argv
-        self.proc = subprocess.Popen(argv, env=env, stdin=subprocess.PIPE,
-                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        self.lines: queue.Queue = queue.Queue()
-        self.seen: list = []
-        self.stderr_lines: list[str] = []
-        threading.Thread(target=self._read, daemon=True).start()
-        threading.Thread(target=self._read_err, daemon=True).start()
+        super().__init__(argv, env, stdin=subprocess.PIPE)
 
     def send(self, line: str) -> None:
         self.proc.stdin.write(line + "\n")
@@ -108,6 +100,7 @@ class SimWorld:
                 proc.proc.wait(5)
             except subprocess.TimeoutExpired:
                 proc.kill()
+            proc.close_pipes()
 
 
 @functools.cache
@@ -152,7 +145,8 @@ def follow_at(world: SimWorld, secs: float, ros1: bool = False) -> Driven:
 
 
 def clock_subscribers(master_uri: str) -> list[str]:
-    _, _, (_, subs, _) = xmlrpc.client.ServerProxy(master_uri).getSystemState("/t")
+    with xmlrpc.client.ServerProxy(master_uri) as master:
+        _, _, (_, subs, _) = master.getSystemState("/t")
     return dict((topic, nodes) for topic, nodes in subs).get("/clock", [])
 
 

@@ -115,7 +115,8 @@ def master(tmp_path, monkeypatch):
 
 
 def server_params(handle) -> dict:
-    code, _, value = xmlrpc.client.ServerProxy(handle.uri).getParam("/test", "/")
+    with xmlrpc.client.ServerProxy(handle.uri) as master:
+        code, _, value = master.getParam("/test", "/")
     assert code == 1
     return value
 

@@ -24,7 +24,7 @@ _FILE = re.compile(r"^(?P<base>.+)-(?P<counter>\d+)(?:-stdout|-stderr)?\.log$")
 
 def run_log_dir(master_uri: str) -> str:
     """The log directory of the run at ``master_uri`` (see the module docstring)."""
-    from orchestra.rpc import TRANSPORT_ERRORS, proxy
+    from orchestra.rpc import TRANSPORT_ERRORS, call
     from orchestra.supervise.output import log_dir_root
     from orchestra.supervise.status import launches_at
 
@@ -33,7 +33,7 @@ def run_log_dir(master_uri: str) -> str:
             return str(launch["log_dir"])
     root = log_dir_root()
     try:
-        answer: Any = proxy(master_uri, timeout=2.0).getParam("/orchestra_logs", "/run_id")
+        answer: Any = call(master_uri, "getParam", "/orchestra_logs", "/run_id", timeout=2.0)
         code, _, run_id = answer
         if code == 1 and isinstance(run_id, str) and os.path.isdir(os.path.join(root, run_id)):
             return os.path.join(root, run_id)

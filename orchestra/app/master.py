@@ -31,7 +31,7 @@ from orchestra.master import (
 )
 from orchestra.master.client import MasterUnreachable
 from orchestra.params.dump import dump_yaml
-from orchestra.rpc import TRANSPORT_ERRORS, proxy
+from orchestra.rpc import TRANSPORT_ERRORS, call, proxy
 
 logger = logging.getLogger(__name__)
 
@@ -62,8 +62,7 @@ def is_loopback_uri(uri: str) -> bool:
 
 def _existing_run_id(uri: str) -> str | None:
     try:
-        master: Any = proxy(uri, timeout=5.0)
-        code, _, value = master.getParam("/roslaunch", "/run_id")
+        code, _, value = call(uri, "getParam", "/roslaunch", "/run_id", timeout=5.0)
     except Exception:  # noqa: BLE001 - a master without /run_id is fine
         return None
     return value if code == 1 and isinstance(value, str) else None
@@ -139,39 +138,40 @@ def run_param_actions(plan: LaunchPlan, uri: str, report: Report) -> None:
     if not plan.param_actions:
         return
     server: Any = proxy(uri, timeout=30.0)   # XML-RPC answers are untyped
-    for action in plan.param_actions:
-        where = f"{action.filename}:{action.line}: " if action.filename else ""
-        try:
-            if action.command == "delete" and action.param == "/":
-                code, message, _ = server.setParam("/roslaunch", "/", {})  # rosparam: empty it
-            elif action.command == "delete":
-                code, message, _ = server.deleteParam("/roslaunch", action.param)
-            else:
-                code, message, value = server.getParam("/roslaunch", action.param)
-        except xmlrpc.client.Fault as exc:
-            code, message = -1, exc.faultString
-        except TRANSPORT_ERRORS as exc:
-            raise MasterUnreachable(f"cannot reach the master at {uri}: {exc}") from None
-        if code != 1:
-            report(f"orchestra: warning: {where}rosparam {action.command}: {message}")
-            continue
-        if action.command == "delete":
-            report(f"rosparam delete {action.param}")
-            continue
-        try:
-            with open(action.file or "", "w", encoding="utf-8") as fh:
-                fh.write(dump_yaml(value))
-        except OSError as exc:
-            report(f"orchestra: warning: {where}rosparam dump: cannot write "
-                   f"[{action.file}]: {exc.strerror}")
-            continue
-        report(f"rosparam dump {action.param} -> {action.file}")
+    with server:   # one connection for every action, closed at the end
+        for action in plan.param_actions:
+            where = f"{action.filename}:{action.line}: " if action.filename else ""
+            try:
+                if action.command == "delete" and action.param == "/":
+                    code, message, _ = server.setParam("/roslaunch", "/", {})  # rosparam: empty it
+                elif action.command == "delete":
+                    code, message, _ = server.deleteParam("/roslaunch", action.param)
+                else:
+                    code, message, value = server.getParam("/roslaunch", action.param)
+            except xmlrpc.client.Fault as exc:
+                code, message = -1, exc.faultString
+            except TRANSPORT_ERRORS as exc:
+                raise MasterUnreachable(f"cannot reach the master at {uri}: {exc}") from None
+            if code != 1:
+                report(f"orchestra: warning: {where}rosparam {action.command}: {message}")
+                continue
+            if action.command == "delete":
+                report(f"rosparam delete {action.param}")
+                continue
+            try:
+                with open(action.file or "", "w", encoding="utf-8") as fh:
+                    fh.write(dump_yaml(value))
+            except OSError as exc:
+                report(f"orchestra: warning: {where}rosparam dump: cannot write "
+                       f"[{action.file}]: {exc.strerror}")
+                continue
+            report(f"rosparam dump {action.param} -> {action.file}")
 
 
 def set_param(uri: str, key: str, value: Any) -> None:
     """Best effort: the launch runs without this entry."""
     try:
-        proxy(uri, timeout=5.0).setParam("/roslaunch", key, value)
+        call(uri, "setParam", "/roslaunch", key, value, timeout=5.0)
     except Exception as exc:  # noqa: BLE001 - the launch runs without this entry
         logger.warning("cannot set %s on the master: %s", key, exc)
 
@@ -179,6 +179,6 @@ def set_param(uri: str, key: str, value: Any) -> None:
 def delete_param(uri: str, key: str) -> None:
     """Best effort: the master may be gone already."""
     try:
-        proxy(uri, timeout=5.0).deleteParam("/roslaunch", key)
+        call(uri, "deleteParam", "/roslaunch", key, timeout=5.0)
     except Exception as exc:  # noqa: BLE001 - master may be gone already
         logger.debug("cannot delete %s: %s", key, exc)

@@ -251,19 +251,19 @@ class LaunchRun:
         """Block until every named thing exists on the run's master: a topic with a
         publisher, a service, a registered node, a parameter. TimeoutError (naming what is
         missing) after ``timeout`` s; RunEnded when the run ends meanwhile."""
-        master = proxy(self.master_uri, timeout=5.0)
         deadline = time.monotonic() + timeout
-        while True:
-            missing = _missing(master, topic, service, node, param)
-            if not missing:
-                return
-            if self._ended.is_set():
-                raise RunEnded(f"the run ended ({self.report.reason if self.report else ''}) "
-                               f"before {missing} appeared")
-            if time.monotonic() >= deadline:
-                raise TimeoutError(f"{missing} did not appear on {self.master_uri} "
-                                   f"within {timeout} s")
-            self._ended.wait(0.05)
+        with proxy(self.master_uri, timeout=5.0) as master:
+            while True:
+                missing = _missing(master, topic, service, node, param)
+                if not missing:
+                    return
+                if self._ended.is_set():
+                    raise RunEnded(f"the run ended ({self.report.reason if self.report else ''}) "
+                                   f"before {missing} appeared")
+                if time.monotonic() >= deadline:
+                    raise TimeoutError(f"{missing} did not appear on {self.master_uri} "
+                                       f"within {timeout} s")
+                self._ended.wait(0.05)
 
     # ------------------------------------------------------------------ internals
 

@@ -51,9 +51,9 @@ def _cli_name(name: str | None, environ: dict[str, str] | None = None) -> str:
 class _Master:
     """The few parameter calls the commands make, with rosparam's error reporting."""
 
-    def __init__(self, uri: str):
+    def __init__(self, uri: str, server: Any):
         self.uri = uri
-        self.server = proxy(uri, timeout=30.0)
+        self.server = server
         self.caller_id = _caller_id()
 
     def call(self, method: str, *args: Any) -> Any:
@@ -107,7 +107,9 @@ def _leaf_sets(name: str, value: Any, location: Location | None = None
 @click.pass_context
 def param(ctx: click.Context, master_uri: str | None) -> None:
     """Get, set, list, delete, load and dump parameters (rosparam compatible)."""
-    ctx.obj = _Master(master_uri or master_uri_from_env())
+    uri = master_uri or master_uri_from_env()
+    # closed with the context: the command may run in-process (tests, click's CliRunner)
+    ctx.obj = _Master(uri, ctx.with_resource(proxy(uri, timeout=30.0)))
 
 
 @param.command("list")

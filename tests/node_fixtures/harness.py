@@ -5,6 +5,7 @@ started here is killed by the fixture's finalizer; every server uses an ephemera
 """
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import queue
@@ -39,15 +40,17 @@ def make_test_package(root: Path) -> Path:
 class NodeProcess:
     """A child process whose stdout JSON lines are collected by a reader thread."""
 
-    def __init__(self, argv: list[str], env: dict[str, str]):
+    def __init__(self, argv: list[str], env: dict[str, str], stdin: int | None = None):
         self.argv = argv
-        self.proc = subprocess.Popen(argv, env=env, stdout=subprocess.PIPE,
+        self.proc = subprocess.Popen(argv, env=env, stdin=stdin, stdout=subprocess.PIPE,
                                      stderr=subprocess.PIPE, text=True)
         self.lines: queue.Queue = queue.Queue()
         self.seen: list = []
         self.stderr_lines: list[str] = []
-        threading.Thread(target=self._read, daemon=True).start()
-        threading.Thread(target=self._read_err, daemon=True).start()
+        self._readers = [threading.Thread(target=self._read, daemon=True),
+                         threading.Thread(target=self._read_err, daemon=True)]
+        for reader in self._readers:
+            reader.start()
 
     def _read(self) -> None:
         for line in self.proc.stdout:
@@ -100,6 +103,20 @@ class NodeProcess:
         except subprocess.TimeoutExpired:
             pass
 
+    def close_pipes(self, timeout: float = 2.0) -> None:
+        """Once the process ended: let the readers reach the end of its output, then close
+        the pipes (left to the garbage collector they are unclosed files, ResourceWarning).
+        A pipe a reader still reads (a grandchild keeps it open) is left alone."""
+        for reader in self._readers:
+            reader.join(timeout)
+        if self.proc.stdin is not None:
+            with contextlib.suppress(OSError):
+                self.proc.stdin.close()
+        if not any(reader.is_alive() for reader in self._readers):
+            for pipe in (self.proc.stdout, self.proc.stderr):
+                if pipe is not None:
+                    pipe.close()
+
 
 ROS_PYTHON = "/usr/bin/python3"   # Debian's Python, where its real ROS 1 tools live
 
@@ -124,6 +141,20 @@ def run_all(jobs: list[tuple[tuple[str, ...], list[str], dict[str, str]]], timeo
     return results
 
 
+class OneShotProxy:
+    """An XML-RPC proxy whose every call has a connection of its own, closed afterwards
+    (``group.master().getSystemState(...)`` leaves no socket to the garbage collector)."""
+
+    def __init__(self, uri: str):
+        self.uri = uri
+
+    def __getattr__(self, method: str):
+        def call(*args):
+            with xmlrpc.client.ServerProxy(self.uri) as proxy:
+                return getattr(proxy, method)(*args)
+        return call
+
+
 class ProcessGroup:
     """Node processes started against one master; ``close()`` stops them, kills stragglers."""
 
@@ -139,8 +170,8 @@ class ProcessGroup:
         self.procs.append(proc)
         return proc
 
-    def master(self) -> xmlrpc.client.ServerProxy:
-        return xmlrpc.client.ServerProxy(self.master_uri)
+    def master(self) -> OneShotProxy:
+        return OneShotProxy(self.master_uri)
 
     def run_all(self, *commands: tuple[str, ...], timeout: float = 20
                 ) -> list[subprocess.CompletedProcess]:
@@ -166,6 +197,8 @@ class ProcessGroup:
                 proc.proc.wait(max(0.1, deadline - time.monotonic()))
             except subprocess.TimeoutExpired:
                 proc.kill()
+        for proc in self.procs:
+            proc.close_pipes()
 
 
 class Nodes(ProcessGroup):
