@@ -16,7 +16,7 @@ import xmlrpc.client
 from collections.abc import Iterable, Mapping
 from http.client import HTTPConnection, HTTPException
 from typing import Any, cast
-from xmlrpc.server import SimpleXMLRPCRequestHandler, SimpleXMLRPCServer
+from xmlrpc.server import SimpleXMLRPCDispatcher
 
 from orchestra.errors import OrchestraError
 
@@ -116,17 +116,118 @@ def multicall_results(multi: xmlrpc.client.MultiCall) -> list[Any]:
 
 # -- server side ------------------------------------------------------------------------------
 
-class AnyPathHandler(SimpleXMLRPCRequestHandler):
-    """Accepts a call posted to any path: rospy and roscpp post to "/", others to "/RPC2"."""
+_REASONS = {200: "OK", 400: "Bad Request", 408: "Request Timeout", 411: "Length Required",
+            413: "Payload Too Large", 414: "URI Too Long", 431: "Request Header Fields Too Large",
+            500: "Internal Server Error", 501: "Not Implemented"}
+MAX_LINE = 65536          # a request or header line longer than this is refused
+MAX_HEADERS = 100
+MAX_BODY = 64 * 2 ** 20   # a ROS call carries params, not bulk data
 
-    rpc_paths = ()
 
-    def log_message(self, format: str, *args: Any) -> None:  # noqa: A002 - http.server's name
-        log.debug("%s " + format, self.address_string(), *args)
+class AnyPathHandler(socketserver.StreamRequestHandler):
+    """A lean HTTP/1.x handler for XML-RPC POSTs to any path (rospy and roscpp post to "/",
+    others to "/RPC2").
+
+    The stdlib's http.server parses every request's headers with the email package and does
+    per-request bookkeeping that costs more than the XML-RPC call itself; a ROS call needs
+    only the request line, Content-Length (and Content-Encoding, Connection). The body goes to
+    the server's dispatcher (``xmlrpc.client.loads``/``dumps``: expat and the stdlib
+    marshaller), whose faults are answered as XML-RPC faults, as SimpleXMLRPCServer does.
+    ``protocol_version = "HTTP/1.1"`` keeps connections open between calls (rospy's and
+    roscpp's clients reuse them); the default answers one call per connection.
+    """
+
+    protocol_version = "HTTP/1.0"
+    # StreamRequestHandler.timeout: seconds a connection may sit idle or take to send a call
+
+    def handle(self) -> None:
+        try:
+            while self._handle_one():
+                pass
+        except OSError:  # an idle connection timed out, or the peer went away
+            pass
+
+    def _handle_one(self) -> bool:
+        """Answer one request; True when the connection stays open for another."""
+        line = self.rfile.readline(MAX_LINE + 1)
+        while line in (b"\r\n", b"\n"):  # tolerated between requests (RFC 9112, 2.2)
+            line = self.rfile.readline(MAX_LINE + 1)
+        if not line:
+            return False
+        if len(line) > MAX_LINE:
+            return self._refuse(414)
+        parts = line.split()
+        if len(parts) != 3 or not parts[2].startswith(b"HTTP/"):
+            return self._refuse(400)
+        method, _, version = parts
+        headers: dict[bytes, bytes] = {}
+        for _ in range(MAX_HEADERS):
+            header = self.rfile.readline(MAX_LINE + 1)
+            if len(header) > MAX_LINE:
+                return self._refuse(431)
+            if header in (b"\r\n", b"\n", b""):
+                break
+            name, colon, value = header.partition(b":")
+            if not colon:
+                return self._refuse(400)
+            headers[name.strip().lower()] = value.strip()
+        else:
+            return self._refuse(431)
+        if method != b"POST":
+            return self._refuse(501)
+        length = headers.get(b"content-length")
+        if length is None:
+            return self._refuse(411)
+        if not length.isdigit():
+            return self._refuse(400)
+        size = int(length)
+        if size > MAX_BODY:
+            return self._refuse(413)
+        body = self.rfile.read(size)
+        if len(body) < size:
+            return False
+        encoding = headers.get(b"content-encoding", b"identity").lower()
+        keep = (self.protocol_version == "HTTP/1.1" and version == b"HTTP/1.1"
+                and headers.get(b"connection", b"").lower() != b"close")
+        try:
+            if encoding == b"gzip":
+                body = xmlrpc.client.gzip_decode(body)
+            elif encoding != b"identity":
+                return self._refuse(501)
+            dispatcher = cast(SimpleXMLRPCDispatcher, self.server)
+            response = cast(bytes, dispatcher._marshaled_dispatch(body))
+        except Exception as exc:  # an undecodable body or a reply that cannot be encoded
+            log.debug("XML-RPC request from %s refused: %s", self.client_address, exc)
+            return self._refuse(500)
+        self._send(200, response, b"text/xml", keep)
+        return keep
+
+    def _refuse(self, status: int) -> bool:
+        """Answer ``status`` with an empty body and close the connection."""
+        self._send(status, b"", b"text/plain", False)
+        return False
+
+    def _send(self, status: int, body: bytes, content_type: bytes, keep: bool) -> None:
+        head = (f"{self.protocol_version} {status} {_REASONS[status]}\r\n"
+                f"Content-type: {content_type.decode()}\r\nContent-length: {len(body)}\r\n"
+                + ("" if keep else "Connection: close\r\n") + "\r\n").encode()
+        self.wfile.write(head + body)
 
 
-class ThreadedServer(socketserver.ThreadingMixIn, SimpleXMLRPCServer):
-    """SimpleXMLRPCServer answering each connection in its own daemon thread.
+class _XMLRPCServer(socketserver.TCPServer, SimpleXMLRPCDispatcher):
+    """TCP server + the stdlib's XML-RPC dispatcher (register_instance/_function, multicall,
+    faults), answering through the lean ``AnyPathHandler``."""
+
+    allow_reuse_address = True
+
+    def __init__(self, addr: tuple[str, int], handler: type[AnyPathHandler] = AnyPathHandler,
+                 allow_none: bool = False, bind_and_activate: bool = True):
+        SimpleXMLRPCDispatcher.__init__(self, allow_none, None)
+        socketserver.TCPServer.__init__(self, addr, handler, bind_and_activate)
+
+
+class ThreadedServer(socketserver.ThreadingMixIn, _XMLRPCServer):
+    """An XML-RPC server answering each connection in its own daemon thread.
 
     Threaded so that one slow call (a node's ``shutdown``, a master notifying a dead node)
     never blocks the others. IPv6 when the bind address is one.
@@ -136,26 +237,24 @@ class ThreadedServer(socketserver.ThreadingMixIn, SimpleXMLRPCServer):
     allow_reuse_address = True
 
     def __init__(self, addr: tuple[str, int],
-                 handler: type[SimpleXMLRPCRequestHandler] = AnyPathHandler,
+                 handler: type[AnyPathHandler] = AnyPathHandler,
                  allow_none: bool = False):
         self.address_family = socket.AF_INET6 if ":" in addr[0] else socket.AF_INET
-        super().__init__(addr, requestHandler=handler, logRequests=False,
-                         allow_none=allow_none, bind_and_activate=True)
+        super().__init__(addr, handler=handler, allow_none=allow_none)
 
     @property
     def port(self) -> int:
         return int(self.server_address[1])
 
 
-class PolledServer(SimpleXMLRPCServer):
+class PolledServer(_XMLRPCServer):
     """A single-threaded server driven by the caller's event loop: ``handle_ready`` answers
     one waiting request. A client gets ``client_timeout`` seconds to send it, so a slow or
     silent client cannot stall the loop."""
 
     def __init__(self, addr: tuple[str, int], allow_none: bool = False,
                  client_timeout: float = 2.0):
-        super().__init__(addr, requestHandler=AnyPathHandler, logRequests=False,
-                         allow_none=allow_none)
+        super().__init__(addr, allow_none=allow_none)
         self.client_timeout = client_timeout
         self.timeout = 0  # handle_request never waits: the loop saw the socket readable
         self.socket.setblocking(False)
