@@ -293,7 +293,8 @@ def test_record_loses_nothing_of_10000_messages_at_1khz(master, tmp_path):
 
 def _subscribed(uri: str, topic: str) -> bool:
     import xmlrpc.client
-    _code, _msg, (_pubs, subs, _srvs) = xmlrpc.client.ServerProxy(uri).getSystemState("/t")
+    with xmlrpc.client.ServerProxy(uri) as proxy:
+        _code, _msg, (_pubs, subs, _srvs) = proxy.getSystemState("/t")
     return any(t == topic and nodes for t, nodes in subs)
 
 
@@ -321,7 +322,8 @@ def test_play_latches_a_topic_that_was_latched_when_recorded(master, tmp_path):
 
 def _published(uri: str, topic: str) -> bool:
     import xmlrpc.client
-    _code, _msg, (pubs, _subs, _srvs) = xmlrpc.client.ServerProxy(uri).getSystemState("/t")
+    with xmlrpc.client.ServerProxy(uri) as proxy:
+        _code, _msg, (pubs, _subs, _srvs) = proxy.getSystemState("/t")
     return any(t == topic and nodes for t, nodes in pubs)
 
 

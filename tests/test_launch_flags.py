@@ -66,7 +66,8 @@ def stop(proc: subprocess.Popen) -> tuple[str, str]:
 
 def master_up(uri: str) -> bool:
     try:
-        return xmlrpc.client.ServerProxy(uri).getPid("/t")[0] == 1
+        with xmlrpc.client.ServerProxy(uri) as proxy:
+            return proxy.getPid("/t")[0] == 1
     except OSError:
         return False
 
@@ -100,15 +101,15 @@ def test_core_runs_a_master_alone_with_roscores_pid_file(env, tmp_path):
     try:
         wait_for(lambda: master_up(uri))
         assert int(pid_file.read_text()) == proc.pid
-        master = xmlrpc.client.ServerProxy(uri)
-        assert master.getParam("/t", "/rosversion")[0] == 1
+        with xmlrpc.client.ServerProxy(uri) as master:
+            assert master.getParam("/t", "/rosversion")[0] == 1
 
-        def graph_nodes() -> set[str]:
-            publishers, subscribers, _ = master.getSystemState("/t")[2]
-            return {n for _, names in publishers + subscribers for n in names}
+            def graph_nodes() -> set[str]:
+                publishers, subscribers, _ = master.getSystemState("/t")[2]
+                return {n for _, names in publishers + subscribers for n in names}
 
-        wait_for(lambda: "/rosout" in graph_nodes())
-        assert graph_nodes() == {"/rosout"}
+            wait_for(lambda: "/rosout" in graph_nodes())
+            assert graph_nodes() == {"/rosout"}
     finally:
         out, err = stop(proc)
     assert proc.returncode == 0, err

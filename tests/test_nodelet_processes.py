@@ -38,7 +38,8 @@ def spawn(master, tmp_path):
 
 
 def publishers(master, topic: str) -> list[str]:
-    state = xmlrpc.client.ServerProxy(master.uri).getSystemState("/test")[2]
+    with xmlrpc.client.ServerProxy(master.uri) as proxy:
+        state = proxy.getSystemState("/test")[2]
     return next((nodes for name, nodes in state[0] if name == topic), [])
 
 

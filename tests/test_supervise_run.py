@@ -318,9 +318,9 @@ def test_launch_registers_its_xmlrpc_uri_on_the_master_like_roslaunch(run_env, m
                 time.sleep(0.02)
             code, _, uris = master.getParam("/t", "/roslaunch/uris")
             seen["uris"] = uris
-            launch = xmlrpc.client.ServerProxy(list(uris.values())[0])
-            seen["pid"] = launch.getPid("/t")[2]
-            seen["processes"] = launch.list_processes("/t")[2]
+            with xmlrpc.client.ServerProxy(list(uris.values())[0]) as launch:
+                seen["pid"] = launch.getPid("/t")[2]
+                seen["processes"] = launch.list_processes("/t")[2]
             cli = subprocess.run([sys.executable, "-m", "orchestra", "status", "--master",
                                   "--json"], capture_output=True, text=True)
             seen["cli"] = json.loads(cli.stdout)
@@ -342,6 +342,7 @@ def test_launch_registers_its_xmlrpc_uri_on_the_master_like_roslaunch(run_env, m
     assert seen["cli"][0]["run_id"] == "testrun"
     # gone from the master when the launch ends (roslaunch leaves stale entries)
     code, _, after = master.getParam("/t", "/roslaunch/uris")
+    master("close")()
     assert code != 1 or key not in after
 
 
