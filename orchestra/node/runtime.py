@@ -14,6 +14,7 @@ import atexit
 import inspect
 import logging
 import os
+import queue
 import signal
 import socket
 import sys
@@ -143,6 +144,8 @@ class NodeRuntime:
         self._shutdown_requested = threading.Event()
         self._shutdown_reason = ""
         self._cleanup: threading.Thread | None = None
+        # set (a plain bool: the signal handler reads it without a lock) when the cleanup ends
+        self.cleanup_finished = False
         # re-entrant: a signal handler runs on the main thread, possibly while that thread is
         # inside signal_shutdown() (e.g. at process exit); it must find the cleanup under way
         # instead of waiting for a lock its own thread holds
@@ -308,6 +311,7 @@ class NodeRuntime:
             self._tcpros.stop()
         if self._slave:
             self._slave.stop()
+        self.cleanup_finished = True
 
 
 def _call_hook(hook: Callable[..., Any], reason: str) -> None:
@@ -381,8 +385,7 @@ def init_node(name: str, argv: list[str] | None = None, anonymous: bool = False,
     _setup_logging(log_level)
     atexit.register(_at_exit)
     if not disable_signals and threading.current_thread() is threading.main_thread():
-        for sig in (signal.SIGINT, signal.SIGTERM):
-            _previous_handlers[sig] = signal.signal(sig, _on_signal)
+        _install_signal_handlers()
     for key, text in parsed.private_params.items():
         try:
             value = _yaml().safe_load(text) if text != "" else ""
@@ -455,17 +458,48 @@ _previous_handlers: dict[int, Any] = {}
 
 _exiting = False
 
+# the signals the handler received, for the signal thread (SimpleQueue.put is re-entrant:
+# safe in a signal handler, even one that interrupted another put)
+_signals: queue.SimpleQueue[int] = queue.SimpleQueue()
+_signal_thread: threading.Thread | None = None
+
+
+def _install_signal_handlers() -> None:
+    """SIGINT/SIGTERM shut the node down; the work runs on the "node-signals" thread."""
+    global _signal_thread
+    if _signal_thread is None:
+        _signal_thread = threading.Thread(target=_handle_signals, name="node-signals",
+                                          daemon=True)
+        _signal_thread.start()
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        _previous_handlers[sig] = signal.signal(sig, _on_signal)
+
 
 def _on_signal(signum, frame) -> None:
-    """First signal: orderly shutdown (``is_shutdown()`` turns true, sleeps raise). A second
-    SIGINT goes to the previous handler (KeyboardInterrupt), for scripts that never look;
-    not once the script has ended (``_exiting``): there a KeyboardInterrupt would only cut
-    the unregistration short and leave the node registered at the master."""
-    already = is_shutdown()
-    signal_shutdown(f"signal {signal.Signals(signum).name}")
+    """Runs on the main thread between two bytecodes of whatever it was doing: inside a
+    ``Condition.wait`` of a sleep, holding a logging or runtime lock, or inside an earlier
+    run of this handler (two SIGINTs within a millisecond). So it takes no lock and logs
+    nothing: it queues the signal, and the signal thread shuts the node down.
+
+    A SIGINT after the shutdown's cleanup has finished goes to the previous handler
+    (KeyboardInterrupt), for scripts that never look at ``is_shutdown()``; not while the
+    cleanup runs (the script is on its way out: an exception raised inside its lock waits
+    would corrupt them) and not once the script has ended (``_exiting``: there a
+    KeyboardInterrupt would only cut the unregistration short)."""
+    rt = context.current_or_none()
     previous = _previous_handlers.get(signum)
-    if already and signum == signal.SIGINT and callable(previous) and not _exiting:
+    if (signum == signal.SIGINT and rt is not None and rt.cleanup_finished
+            and callable(previous) and not _exiting):
         previous(signum, frame)
+        return
+    _signals.put(signum)
+
+
+def _handle_signals() -> None:
+    """The signal thread: the shutdown work of each signal, on a normal thread."""
+    while True:
+        signum = _signals.get()
+        signal_shutdown(f"signal {signal.Signals(signum).name}")
 
 
 def _at_exit() -> None:

@@ -8,6 +8,8 @@ thing when the master is down and starts its node the same way.
 """
 from __future__ import annotations
 
+import signal
+import threading
 from types import ModuleType
 
 from orchestra.rpc import MasterUnreachable, master_is_up, master_uri_from_env
@@ -36,7 +38,25 @@ def start_cli_node() -> ModuleType:
     require_master(master_uri())
     rospy.init_node(CLI_NODE, argv=[], anonymous=True, disable_signals=True,
                     disable_rosout=True, disable_rostime=True)
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, _interrupt_once)
     return rospy
+
+
+_interrupted = False
+
+
+def _interrupt_once(signum, frame) -> None:
+    """A tool's SIGINT: the first raises KeyboardInterrupt (the tool's loop ends and its
+    node unregisters), later ones are ignored. A second KeyboardInterrupt would land inside
+    the unwinding of the first, e.g. in the middle of ``Condition.wait`` re-taking its lock
+    ("release unlocked lock") or of the node's shutdown ("cannot join thread before it is
+    started"): a traceback instead of the clean exit rostopic gives."""
+    global _interrupted
+    if _interrupted:
+        return
+    _interrupted = True
+    raise KeyboardInterrupt
 
 
 def stop_cli_node(reason: str) -> None:
