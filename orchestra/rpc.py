@@ -8,10 +8,12 @@ picture, so master, node and supervise cannot drift apart (and need not import e
 """
 from __future__ import annotations
 
+import atexit
 import logging
 import os
 import socket
 import socketserver
+import threading
 import xmlrpc.client
 from collections.abc import Iterable, Mapping
 from http.client import HTTPConnection, HTTPException
@@ -75,6 +77,69 @@ def call(uri: str, method: str, *args: Any, timeout: float | None = None) -> Any
     proxy otherwise holds its socket until it is garbage-collected)."""
     with proxy(uri, timeout) as server:
         return getattr(server, method)(*args)
+
+
+class _ProxyPool:
+    """Idle XML-RPC proxies by (uri, timeout), lent out to one call at a time.
+
+    A new connection per call costs ~0.6 ms on loopback (connect, and a server thread per
+    connection), five times a call on an open keep-alive connection; rospy likewise keeps
+    its proxies. Each proxy is used by one thread at a time (they are not thread-safe); a
+    stale kept-alive connection (peer restarted, idle timeout) is re-opened by
+    xmlrpc.client's transport, which retries once on a reset. A call that fails on the wire
+    drops its proxy.
+    """
+
+    MAX_IDLE = 8  # per (uri, timeout): more concurrent callers than that open their own
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._idle: dict[tuple[str, float | None], list[xmlrpc.client.ServerProxy]] = {}
+
+    def call(self, uri: str, method: str, *args: Any, timeout: float | None = None) -> Any:
+        key = (uri, timeout)
+        with self._lock:
+            idle = self._idle.get(key)
+            server = idle.pop() if idle else None
+        if server is None:
+            server = proxy(uri, timeout)
+        try:
+            result = getattr(server, method)(*args)
+        except xmlrpc.client.Fault:
+            self._give_back(key, server)
+            raise
+        except BaseException:
+            server("close")()
+            raise
+        self._give_back(key, server)
+        return result
+
+    def _give_back(self, key: tuple[str, float | None], server: xmlrpc.client.ServerProxy
+                   ) -> None:
+        with self._lock:
+            idle = self._idle.setdefault(key, [])
+            if len(idle) < self.MAX_IDLE:
+                idle.append(server)
+                return
+        server("close")()
+
+    def close(self) -> None:
+        """Close every idle connection (at exit, so none is left to the garbage collector)."""
+        with self._lock:
+            servers = [s for idle in self._idle.values() for s in idle]
+            self._idle.clear()
+        for server in servers:
+            server("close")()
+
+
+_POOL = _ProxyPool()
+atexit.register(_POOL.close)
+
+
+def pooled_call(uri: str, method: str, *args: Any, timeout: float | None = None) -> Any:
+    """``method(*args)`` at ``uri`` over a kept connection (see ``_ProxyPool``): for callers
+    that talk to the same peers again and again, as a node does with its master."""
+    return _POOL.call(uri, method, *args, timeout=timeout)
 
 
 def master_is_up(uri: str, timeout: float = 1.0) -> bool:

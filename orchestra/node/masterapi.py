@@ -1,9 +1,9 @@
 """XML-RPC clients for the ROS Master and for other nodes' slave APIs.
 
 Every ROS XML-RPC call answers ``[code, statusMessage, value]``: 1 success, 0 failure, -1
-error. ``call`` unwraps that. A new ``ServerProxy`` is made per call because xmlrpc.client's
-proxies keep one HTTP connection and are not safe to share between threads; on loopback the
-extra connect costs tens of microseconds.
+error. ``call`` unwraps that. Calls go over kept connections (``rpc.pooled_call``: one
+proxy per call at a time, as xmlrpc.client's proxies are not thread-safe), since opening a
+connection per call costs several times the call itself.
 """
 from __future__ import annotations
 
@@ -28,7 +28,7 @@ class MasterError(ROSException):
 def raw_call(uri: str, method: str, *args: Any, timeout: float = DEFAULT_TIMEOUT) -> list:
     """``[code, msg, value]`` from ``method`` at ``uri``; unreachable -> MasterError."""
     try:
-        result = rpc.call(uri, method, *args, timeout=timeout)
+        result = rpc.pooled_call(uri, method, *args, timeout=timeout)
     except TRANSPORT_ERRORS as exc:
         raise MasterError(f"cannot reach {uri} ({method}): {exc}") from exc
     except xmlrpc.client.Fault as exc:
