@@ -236,6 +236,9 @@ def launch(ctx: click.Context, words: tuple[str, ...], dump_plan: bool, dump_par
            nodes: bool, node_args: str | None, files: bool, find_node: str | None,
            ros_args: bool, no_exec: bool, core_only: bool, **run_opts: Any) -> None:
     """Resolve and run a roslaunch file: orchestra launch [PKG] FILE [name:=value ...]."""
+    from orchestra.supervise import stop_signals
+
+    stop_signals.record()   # first: a Ctrl-C from here on is an orderly stop, never lost
     from orchestra.launch.load import find_node as find_declared
     from orchestra.launch.load import interpret, ros_args_text
 

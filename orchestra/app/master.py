@@ -32,6 +32,7 @@ from orchestra.master import (
 from orchestra.master.client import MasterUnreachable
 from orchestra.params.dump import dump_yaml
 from orchestra.rpc import TRANSPORT_ERRORS, call, proxy
+from orchestra.supervise import stop_signals
 
 logger = logging.getLogger(__name__)
 
@@ -90,6 +91,8 @@ def connect_master(options: RunOptions, report: Report, public: bool = False
     if options.wait:
         report(f"waiting for the master at {uri} ...")
         while not master_is_up(uri):
+            if stop_signals.pending():   # recorded by the launch command (Ctrl-C)
+                raise KeyboardInterrupt
             time.sleep(0.2)
         run_id = _existing_run_id(uri) or options.run_id or str(uuid.uuid1())
         return MasterConnection(uri, None, run_id)

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 
 import psutil
 
+from orchestra.supervise import stop_signals
 from orchestra.supervise.limits import (
     cgroup_unavailable,
     cpu_cgroup,
@@ -58,7 +59,7 @@ from orchestra.supervise.reaper import (
 
 logger = logging.getLogger(__name__)
 
-_STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+_STOP_SIGNALS = stop_signals.STOP_SIGNALS
 
 
 @dataclass
@@ -270,6 +271,9 @@ class Supervisor:
         """
         restore = self._install_signals() if install_signals else None
         try:
+            if restore is not None:   # a stop signal that came before they were ours
+                for signum in stop_signals.take():
+                    self._stop_signal(signum)
             if before_start is not None:
                 before_start()
             self.start_all()
@@ -529,17 +533,7 @@ class Supervisor:
             except BlockingIOError:
                 return
             for signum in data:
-                if signum not in _STOP_SIGNALS:
-                    continue
-                self._signal_count += 1
-                name = signal.Signals(signum).name
-                if self._signal_count == 1:
-                    self.screen.message(f"orchestra: {name} received, stopping all nodes",
-                                        err=True)
-                    self.request_stop(f"{name} received")
-                else:
-                    self.screen.message(f"orchestra: {name} again, killing all nodes", err=True)
-                    self.kill_all()
+                self._stop_signal(signum)
 
         self.loop.add_reader(read_fd, on_signal)
 
@@ -552,6 +546,19 @@ class Supervisor:
             os.close(write_fd)
 
         return restore
+
+    def _stop_signal(self, signum: int) -> None:
+        """The first stop signal: orderly stop; any further one: SIGKILL what is left."""
+        if signum not in _STOP_SIGNALS:
+            return
+        self._signal_count += 1
+        name = signal.Signals(signum).name
+        if self._signal_count == 1:
+            self.screen.message(f"orchestra: {name} received, stopping all nodes", err=True)
+            self.request_stop(f"{name} received")
+        else:
+            self.screen.message(f"orchestra: {name} again, killing all nodes", err=True)
+            self.kill_all()
 
     def _stop_strays(self) -> None:
         """Stop what nodes left running outside their process groups (setsid, daemons).
