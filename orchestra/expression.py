@@ -727,9 +727,25 @@ def _parse(text: str, policy: Policy) -> ast.Expression:
             warnings.simplefilter("ignore", SyntaxWarning)
             return ast.parse(text.strip(), mode="eval")
     except SyntaxError as exc:
-        raise _Refused(f"not a valid expression: {exc.msg}") from None
+        raise _Refused(f"not a valid expression: {exc.msg} at {_error_place(text, exc)}") from None
     except (RecursionError, MemoryError):
         raise _Refused("the expression is nested too deeply") from None
+
+
+def _error_place(text: str, exc: SyntaxError) -> str:
+    """Where in ``text`` (as the user wrote it, leading blanks included) the syntax error
+    is: "column N" (1-based), "line L column N" past the first line, or "the end" (column
+    N) where Python reports none (offset 0: the input ended too early, as in "topic ==")."""
+    stripped = text.strip()
+    lead = len(text) - len(text.lstrip())
+    line = exc.lineno or 1
+    lines = stripped.split("\n")
+    if line > 1 and line <= len(lines):
+        column = exc.offset if exc.offset and exc.offset > 0 else len(lines[line - 1]) + 1
+        return f"line {line} column {column}"
+    if not exc.offset or exc.offset <= 0 or exc.offset > len(lines[0]):
+        return f"the end (column {lead + len(lines[0]) + 1})"
+    return f"column {lead + exc.offset}"
 
 
 def validate(tree: ast.Expression, policy: Policy,

@@ -71,3 +71,15 @@ def test_filter_refuses_attributes_that_are_not_message_data(text, why):
 def test_filter_refuses_expressions_that_would_exhaust_memory_or_time(text):
     with pytest.raises(ExpressionError):
         _run(text, "image")
+
+
+@pytest.mark.parametrize("text, place", [
+    ("topic ==", "at the end (column 9)"),
+    ("  topic = 1", "at column 9"),
+    ("topic == 'a' and (m", "'(' was never closed at column 18"),
+    ("a b", "at column 3"),
+])
+def test_a_syntax_error_names_the_column_where_it_is(text, place):
+    with pytest.raises(ExpressionError) as info:
+        compile_expression(text, frozenset({"topic", "m", "t"}))
+    assert str(info.value).endswith(place)

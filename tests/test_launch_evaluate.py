@@ -156,3 +156,8 @@ def test_eval_error_is_an_orchestra_error():
     with pytest.raises(EvalError):
         ev.evaluate("1/0", {}, {name: (lambda *a: None) for name in ev.LAUNCH_FUNCTIONS},
                     str)
+
+
+def test_an_eval_syntax_error_names_its_column_as_bag_filter_does():
+    assert (problem("1 + ) 2") or "").endswith("at column 5")
+    assert (problem("1 +") or "").endswith("at the end (column 4)")
