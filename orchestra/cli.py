@@ -101,7 +101,26 @@ class LazyGroup(click.Group):
         module_name, attr = entry[0].split(":")
         command = getattr(importlib.import_module(module_name), attr)
         assert isinstance(command, click.Command)
+        _plain_help(command)
         return command
+
+
+def _plain_help(command: click.Command) -> None:
+    """Drop the docstrings' reST literal markup (````name````) from the help of ``command``,
+    its options and sub-commands: the docstrings are written for the code's readers and
+    double as ``--help``, where the backticks would only be noise. Here once, for every
+    command, rather than in each docstring."""
+    for attr in ("help", "short_help", "epilog"):
+        text = getattr(command, attr, None)
+        if text:
+            setattr(command, attr, text.replace("``", ""))
+    for param in command.params:
+        text = getattr(param, "help", None)
+        if text:
+            param.help = text.replace("``", "")   # type: ignore[attr-defined]
+    if isinstance(command, click.Group):
+        for sub in command.commands.values():
+            _plain_help(sub)
 
 
 @click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})

@@ -40,3 +40,23 @@ def test_help_imports_no_sub_command():
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           timeout=60)
     assert proc.stdout.strip().endswith("[] False False"), proc.stdout + proc.stderr
+
+
+def test_no_help_shows_the_docstrings_rest_literal_markup():
+    """``orchestra export --help`` showed ````local````: the docstrings' markup leaked."""
+    import click
+
+    from orchestra.cli import COMMANDS, cli
+
+    def helps(command, path):
+        with click.Context(command, info_name=" ".join(path)) as ctx:
+            yield " ".join(path), command.get_help(ctx)
+            if isinstance(command, click.Group):
+                for name in command.list_commands(ctx):
+                    yield from helps(command.get_command(ctx, name), [*path, name])
+
+    with click.Context(cli) as ctx:
+        pages = dict(item for name in COMMANDS
+                     for item in helps(cli.get_command(ctx, name), ["orchestra", name]))
+    assert "orchestra node stop" in pages and "orchestra export" in pages
+    assert [path for path, text in pages.items() if "``" in text] == []
