@@ -115,3 +115,29 @@ def test_plot_live_topic_to_a_picture(master, tmp_path):
         assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     finally:
         pub.kill()
+
+
+def test_plot_live_waits_for_a_topic_that_does_not_exist_yet(master, tmp_path):
+    """rqt_plot waits for the topic; ``orchestra plot`` said "no such topic" at once."""
+    env = dict(os.environ, ROS_MASTER_URI=master.uri, PYTHONUNBUFFERED="1")
+    env.pop("DISPLAY", None)
+    env.pop("ROS_NAMESPACE", None)
+    out = tmp_path / "late.png"
+    plot = subprocess.Popen([sys.executable, "-m", "orchestra", "plot", "/late/linear/x",
+                             "--out", str(out), "--duration", "1.5"], env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    pub = None
+    try:
+        assert "waiting for topic /late/linear/x" in plot.stderr.readline()
+        pub = NodeProcess([sys.executable, str(HERE / "node_fixtures" / "pub.py"), "/late",
+                           "geometry_msgs/Twist", "linear: {x: $N}", "--rate", "50"], env)
+        pub.ready(timeout=20)
+        _, err = plot.communicate(timeout=60)
+        assert plot.returncode == 0 and "no data" not in err, err
+        assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    finally:
+        if plot.poll() is None:
+            plot.kill()
+            plot.communicate()
+        if pub is not None:
+            pub.kill()

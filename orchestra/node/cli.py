@@ -19,7 +19,13 @@ from orchestra.errors import OrchestraError
 from orchestra.node import introspect
 from orchestra.node.exceptions import ROSException
 from orchestra.node.loggers import LEVEL_NAMES
-from orchestra.node.tool import master_uri, start_cli_node, stop_cli_node
+from orchestra.node.tool import (
+    master_uri,
+    split_field_path,
+    start_cli_node,
+    stop_cli_node,
+    wait_for_topic,
+)
 
 
 class CommandFailed(OrchestraError):
@@ -383,7 +389,7 @@ def topic_echo(name: str, count: int | None, noarr: bool) -> None:
         if topic not in state.publishers:
             click.echo(f"WARNING: topic [{topic}] does not appear to be published yet", err=True)
         if topic not in state.topics:  # maybe TOPIC/FIELD: which part is the topic comes later
-            topic, fields = _wait_for_topic(name)
+            topic, fields = wait_for_topic(name)
         name = topic
         _sub, inbox = _subscribe_raw(rospy, name)
         while count is None or printed < count:
@@ -404,18 +410,6 @@ def topic_echo(name: str, count: int | None, noarr: bool) -> None:
         stop_cli_node("topic echo done")
 
 
-def _wait_for_topic(path: str) -> tuple[str, list[str]]:
-    """Poll the master until ``path`` or a prefix of it is a known topic, as rostopic echo
-    waits for the topic's type: only then can ``/cmd_vel/linear/x`` be split into topic
-    and fields."""
-    while True:
-        topics = introspect.system_state(master_uri()).topics
-        topic, fields = split_field_path(path, topics)
-        if topic in topics:
-            return topic, fields
-        time.sleep(0.1)
-
-
 def hide_arrays(msg) -> None:
     """``--noarr``: each array field of ``msg`` (top level only) becomes rostopic's
     ``<array type: T, length: N>`` text; T is the field type with its trailing brackets
@@ -425,19 +419,6 @@ def hide_arrays(msg) -> None:
             length = len(getattr(msg, field_name))
             setattr(msg, field_name,
                     f"<array type: {slot_type.rstrip('[]')}, length: {length}>")
-
-
-def split_field_path(name: str, topics: list[str]) -> tuple[str, list[str]]:
-    """``/turtle1/pose/x`` -> (``/turtle1/pose``, ``["x"]``) when only the prefix is a topic
-    (rostopic echo's field selection); a name that is a topic is returned whole."""
-    if name in topics:
-        return name, []
-    parts = name.split("/")
-    for cut in range(len(parts) - 1, 1, -1):
-        prefix = "/".join(parts[:cut])
-        if prefix in topics:
-            return prefix, parts[cut:]
-    return name, []
 
 
 def pick_field(msg, fields: list[str]):
@@ -705,4 +686,3 @@ def graph(out: str | None, show_all: bool) -> None:
         raise OrchestraError(f"cannot write {out}: {exc.strerror or exc}") from None
     click.echo(f"wrote {out} ({g.number_of_nodes()} vertices, {g.number_of_edges()} edges)",
                err=True)
-

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import signal
 import threading
+import time
 from types import ModuleType
 
 from orchestra.rpc import MasterUnreachable, master_is_up, master_uri_from_env
@@ -63,3 +64,30 @@ def stop_cli_node(reason: str) -> None:
     """End the tool's node (unregisters it from the master)."""
     from orchestra.node import runtime
     runtime.reset(reason)
+
+
+def wait_for_topic(path: str) -> tuple[str, list[str]]:
+    """Poll the master until ``path`` or a prefix of it is a known topic, as rostopic echo
+    and rqt_plot wait for the topic's type: only then can ``/cmd_vel/linear/x`` be split
+    into topic and fields. Returns what ``split_field_path`` makes of it."""
+    from orchestra.node import introspect  # only for the tools that wait
+
+    while True:
+        topics = introspect.system_state(master_uri()).topics
+        topic, fields = split_field_path(path, topics)
+        if topic in topics:
+            return topic, fields
+        time.sleep(0.1)
+
+
+def split_field_path(name: str, topics: list[str]) -> tuple[str, list[str]]:
+    """``/turtle1/pose/x`` -> (``/turtle1/pose``, ``["x"]``) when only the prefix is a topic
+    (rostopic echo's field selection); a name that is a topic is returned whole."""
+    if name in topics:
+        return name, []
+    parts = name.split("/")
+    for cut in range(len(parts) - 1, 1, -1):
+        prefix = "/".join(parts[:cut])
+        if prefix in topics:
+            return prefix, parts[cut:]
+    return name, []

@@ -123,11 +123,24 @@ def plot(specs: tuple[str, ...], bag_path: str | None, out: str | None, duration
 
 def _plot_live(specs: tuple[str, ...], out: str | None, duration: float, title: str) -> None:
     from orchestra.node import introspect
-    from orchestra.node.tool import master_uri, start_cli_node, stop_cli_node
+    from orchestra.node.tool import (
+        master_uri,
+        split_field_path,
+        start_cli_node,
+        stop_cli_node,
+        wait_for_topic,
+    )
     from orchestra.plot import figure
     start_cli_node()
     try:
         state = introspect.system_state(master_uri())
+        for spec in specs:   # as rqt_plot: a topic not there yet is waited for, not an error
+            first = "/" + spec.split(":")[0].lstrip("/")
+            topic, _ = split_field_path(first, state.topics)
+            if topic not in state.topics:
+                click.echo(f"waiting for topic {first} ...", err=True)
+                wait_for_topic(first)
+                state = introspect.system_state(master_uri())
         series = _parse(specs, sorted(state.topics))
         source = LiveSource(series)
         if out is None:
