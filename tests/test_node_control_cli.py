@@ -3,17 +3,16 @@ from __future__ import annotations
 
 import os
 import signal
-import socket
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
-from harness import wait_for  # noqa: E402
-
 pytestmark = pytest.mark.timeout(90)
+
+sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
+from harness import demo_package, free_port, wait_for  # noqa: E402
 
 LAUNCH = """<launch>
   <node pkg="demo" type="sleeper" name="a"/>
@@ -25,23 +24,10 @@ LAUNCH = """<launch>
 """
 
 
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
-
-
 @pytest.fixture
 def env(tmp_path):
-    pkg = tmp_path / "ws" / "demo"
-    (pkg / "nodes").mkdir(parents=True)
+    pkg = demo_package(tmp_path / "ws", {"sleeper": "#!/bin/sh\nexec sleep 1000\n"})
     (pkg / "launch").mkdir()
-    (pkg / "package.xml").write_text(
-        "<package format='2'><name>demo</name><version>0.0.0</version><description>d"
-        "</description><maintainer email='a@b.c'>a</maintainer><license>BSD</license></package>")
-    node = pkg / "nodes" / "sleeper"
-    node.write_text("#!/bin/sh\nexec sleep 1000\n")
-    node.chmod(0o755)
     (pkg / "launch" / "demo.launch").write_text(LAUNCH)
     environ = {k: v for k, v in os.environ.items()
                if k not in ("ROS_LOG_DIR", "ROS_NAMESPACE", "CMAKE_PREFIX_PATH")}

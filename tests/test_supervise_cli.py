@@ -4,7 +4,6 @@ from __future__ import annotations
 import contextlib
 import os
 import signal
-import socket
 import subprocess
 import sys
 import time
@@ -14,6 +13,9 @@ import psutil
 import pytest
 
 pytestmark = pytest.mark.timeout(90)
+
+sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
+from harness import demo_package, free_port  # noqa: E402
 
 NODE = """#!/bin/sh
 # a node that forks a helper (same process group), records both pids, and waits
@@ -33,23 +35,10 @@ LAUNCH = """<launch>
 """
 
 
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
-
-
 @pytest.fixture
 def launch_env(tmp_path):
-    pkg = tmp_path / "ws" / "demo"
-    (pkg / "nodes").mkdir(parents=True)
+    pkg = demo_package(tmp_path / "ws", {"forker": NODE})
     (pkg / "launch").mkdir()
-    (pkg / "package.xml").write_text(
-        "<package format='2'><name>demo</name><version>0.0.0</version><description>d"
-        "</description><maintainer email='a@b.c'>a</maintainer><license>BSD</license></package>")
-    node = pkg / "nodes" / "forker"
-    node.write_text(NODE)
-    node.chmod(0o755)
     (pkg / "launch" / "demo.launch").write_text(LAUNCH)
     pids = tmp_path / "pids"
     pids.mkdir()

@@ -10,6 +10,7 @@ import json
 import os
 import queue
 import signal
+import socket
 import subprocess
 import sys
 import threading
@@ -35,6 +36,27 @@ def make_test_package(root: Path) -> Path:
     (pkg / "msg" / "Num.msg").write_text(NUM_MSG)
     (pkg / "srv" / "AddTwoInts.srv").write_text(ADD_TWO_INTS)
     return root
+
+
+def free_port() -> int:
+    """A TCP port nothing listens on right now (for a master of the test's own)."""
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+def demo_package(ws: Path, nodes: dict[str, str], name: str = "demo") -> Path:
+    """A catkin package ``name`` under ``ws`` whose ``nodes/`` holds executable scripts."""
+    pkg = ws / name
+    (pkg / "nodes").mkdir(parents=True)
+    (pkg / "package.xml").write_text(
+        f"<package format='2'><name>{name}</name><version>0.0.0</version><description>d"
+        "</description><maintainer email='a@b.c'>a</maintainer><license>BSD</license></package>")
+    for exe, text in nodes.items():
+        path = pkg / "nodes" / exe
+        path.write_text(text)
+        path.chmod(0o755)
+    return pkg
 
 
 class NodeProcess:
