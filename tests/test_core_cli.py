@@ -3,22 +3,19 @@ from __future__ import annotations
 
 import os
 import signal
-import socket
 import subprocess
 import sys
 import xmlrpc.client
+from pathlib import Path
 
 import pytest
 
 from orchestra.master import master_is_up
 
+sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
+from harness import free_port  # noqa: E402
+
 pytestmark = pytest.mark.timeout(60)
-
-
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 @pytest.fixture
@@ -70,7 +67,7 @@ def test_core_stops_on_xmlrpc_shutdown(core):
 
 
 def test_core_takes_port_from_ros_master_uri(core):
-    port = _free_port()
+    port = free_port()
     proc, uri = core(env={"ROS_MASTER_URI": f"http://localhost:{port}/"})
     assert uri == f"http://127.0.0.1:{port}/"
     assert master_is_up(uri)

@@ -7,11 +7,11 @@ observer instead of sharing the pytest process with other tests' masters.
 """
 from __future__ import annotations
 
+import itertools
 import json
 import math
 import os
 import signal
-import socket
 import subprocess
 import sys
 import threading
@@ -19,6 +19,9 @@ import time
 from pathlib import Path
 
 import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
+from harness import free_port  # noqa: E402
 
 # orchestra's bundled packages, whatever ROS workspace the developer's shell points at
 BUNDLED_ENV = {k: v for k, v in os.environ.items()
@@ -28,12 +31,6 @@ REPO = Path(__file__).resolve().parent.parent
 PEN = (179, 184, 255)
 PX_PER_METER = 45.0
 WORLD = (500 - 1) / PX_PER_METER
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 class Observer:
@@ -143,6 +140,23 @@ def wait_until_close(launch: Launch, observer: Observer, a: str, b: str, within:
                 f"{launch.output()}")
 
 
+def travelled(samples: list[dict]) -> float:
+    """Length in metres of the path through a topic's pose samples."""
+    return sum(math.dist((a["x"], a["y"]), (b["x"], b["y"])) for a, b in itertools.pairwise(samples))
+
+
+def wait_until_travelled(launch: Launch, observer: Observer, topics: tuple[str, ...],
+                         metres: float, within: float) -> None:
+    """Wait until every topic's turtle has moved ``metres`` along its path."""
+    while launch.elapsed() < within:
+        if all(travelled(observer.samples[t]) >= metres for t in topics):
+            return
+        assert launch.proc.poll() is None, f"launch exited early:\n{launch.output()}"
+        time.sleep(0.05)
+    paths = {t: round(travelled(observer.samples[t]), 2) for t in topics}
+    pytest.fail(f"turtles did not travel {metres} m in {within} s: {paths}\n{launch.output()}")
+
+
 @pytest.mark.timeout(60)
 def test_start_tf_demo_auto_driver_turtle2_reaches_turtle1_within_15_seconds(run_demo):
     launch, observer = run_demo(["learning_tf", "start_tf_demo.launch", "driver:=auto"],
@@ -161,8 +175,9 @@ def test_turtle_tf_demo_snapshot_shows_both_turtles_trails(run_demo, tmp_path):
     png = tmp_path / "turtle_tf.png"
     launch, observer = run_demo(["turtle_tf", "turtle_tf_demo.launch", "driver:=auto",
                                  f"snapshot:={png}"], ["/turtle1/pose", "/turtle2/pose"])
-    reached = wait_until_close(launch, observer, "/turtle1/pose", "/turtle2/pose", within=15.0)
-    time.sleep(max(0.0, 9.0 - reached))  # let both draw a while longer
+    wait_until_close(launch, observer, "/turtle1/pose", "/turtle2/pose", within=15.0)
+    # let both draw trails of several metres (the pen-pixel count below needs them)
+    wait_until_travelled(launch, observer, ("/turtle1/pose", "/turtle2/pose"), 5.0, within=30.0)
     assert launch.stop() == 0
     width, height, pixels = read_png(png.read_bytes())  # written at shutdown
     assert (width, height) == (500, 500)

@@ -7,7 +7,6 @@ import os
 import re
 import shlex
 import shutil
-import socket
 import subprocess
 import sys
 from pathlib import Path
@@ -17,7 +16,7 @@ import pytest
 from orchestra.supervise.interactive import parse_keys
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
-from harness import wait_for  # noqa: E402
+from harness import free_port, wait_for  # noqa: E402
 
 pytestmark = pytest.mark.timeout(90)
 
@@ -32,12 +31,6 @@ LAUNCH = """<launch>
 def test_key_bytes_become_key_names():
     assert parse_keys(b"\x1b[A\x1b[Bjk/cam\r\x7f\x1b\x1b[Cq") == [
         "up", "down", "j", "k", "/", "c", "a", "m", "enter", "backspace", "esc", "q"]
-
-
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
 
 
 class Pane:

@@ -15,7 +15,6 @@ import os
 import re
 import shlex
 import signal
-import socket
 import subprocess
 import sys
 import time
@@ -25,7 +24,7 @@ import pytest
 import yaml
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
-from harness import ROS_PYTHON, NodeProcess, OneShotProxy, ProcessGroup, wait_for  # noqa: E402
+from harness import ROS_PYTHON, NodeProcess, OneShotProxy, ProcessGroup, free_port, wait_for  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 PEER = HERE / "ros1_nodes" / "peer.py"
@@ -55,12 +54,6 @@ def _ros_env(extra: dict[str, str]) -> dict[str, str]:
 _MISSING = _real_ros_missing()
 pytestmark = [pytest.mark.skipif(_MISSING is not None, reason=_MISSING or ""),
               pytest.mark.timeout(60)]
-
-
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
 
 
 class Side(ProcessGroup):
@@ -94,8 +87,6 @@ class Side(ProcessGroup):
 
     def background_tool(self, *argv: str) -> NodeProcess:
         return self._start([ROS_PYTHON, f"/usr/bin/{argv[0]}", *argv[1:]], self.ros_env)
-
-
 
 
 @pytest.fixture
@@ -435,7 +426,6 @@ def test_real_rosparam_sets_gets_dumps_and_loads_on_orchestra_master(side, maste
     assert listed.stdout.split() == ["/copy/limits/names", "/copy/limits/speed", "/copy/mode"]
     assert side.tool("rosparam", "delete", "/copy/mode").returncode == 0
     assert not master.params.has("/copy/mode")
-
 
 
 PARAM_VALUES = {"/f": 1.5, "/big": 2**31 - 1, "/neg": -3, "/s": "a: b", "/t": True, "/e": {},

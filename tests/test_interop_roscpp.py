@@ -19,7 +19,6 @@ import os
 import re
 import shlex
 import signal
-import socket
 import subprocess
 import sys
 from pathlib import Path
@@ -27,7 +26,7 @@ from pathlib import Path
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
-from harness import ROS_PYTHON, NodeProcess, OneShotProxy, ProcessGroup, wait_for  # noqa: E402
+from harness import ROS_PYTHON, NodeProcess, OneShotProxy, ProcessGroup, free_port, wait_for  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
@@ -64,12 +63,6 @@ def _skip_unless(*paths: str | Path) -> None:
     reason = _absent(*paths)
     if reason:
         pytest.skip(reason)
-
-
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
 
 
 @pytest.fixture(scope="module")
@@ -124,7 +117,6 @@ class Graph(ProcessGroup):
         """getSystemState as {name: set(nodes)} for publishers, subscribers, services."""
         lists = self.master().getSystemState("/probe")[2]
         return tuple({name: set(nodes) for name, nodes in rows} for rows in lists)
-
 
 
 @pytest.fixture

@@ -5,7 +5,6 @@ from __future__ import annotations
 import os
 import re
 import signal
-import socket
 import subprocess
 import sys
 import xmlrpc.client
@@ -17,7 +16,7 @@ from orchestra.app.cli import log_size_warning
 from orchestra.launch.summary import summary_value
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
-from harness import ROS_PYTHON, wait_for  # noqa: E402
+from harness import ROS_PYTHON, free_port, wait_for  # noqa: E402
 
 pytestmark = pytest.mark.timeout(90)
 REPO = Path(__file__).resolve().parent.parent
@@ -28,12 +27,6 @@ LAUNCH = """<launch>
   <group ns="g"><node pkg="demo" type="sleeper" name="b"/></group>
 </launch>
 """
-
-
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
 
 
 @pytest.fixture

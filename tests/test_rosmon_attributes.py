@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import os
-import socket
 import subprocess
 import sys
 import time
@@ -18,7 +17,7 @@ from orchestra.launch.plan import Node
 from orchestra.supervise.specs import SpecOptions, build_specs
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
-from harness import wait_for  # noqa: E402
+from harness import free_port, wait_for  # noqa: E402
 
 pytestmark = pytest.mark.timeout(90)
 
@@ -92,12 +91,6 @@ blocks = []
 while True:
     blocks.append(bytearray(8 << 20))
 """
-
-
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
 
 
 def test_launch_honours_stop_timeout_and_memory_limit(tmp_path):

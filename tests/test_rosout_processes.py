@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import os
 import signal
-import socket
 import subprocess
 import sys
 import time
@@ -15,6 +14,9 @@ from pathlib import Path
 
 import psutil
 import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
+from harness import free_port  # noqa: E402
 
 pytestmark = pytest.mark.timeout(60)
 
@@ -35,12 +37,6 @@ while not node.is_shutdown():
 '''
 
 LAUNCH = '<launch><node pkg="demo" type="talker" name="talker"/></launch>\n'
-
-
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
 
 
 @pytest.fixture

@@ -3,11 +3,11 @@ from __future__ import annotations
 
 import json
 import os
-import socket
 import subprocess
 import sys
 import threading
 import time
+from pathlib import Path
 
 import pytest
 
@@ -19,6 +19,9 @@ from orchestra.supervise.output import Screen
 from orchestra.supervise.process import OutputMode, ProcessSpec, State
 from orchestra.supervise.status import ProcessStats, StatusServer, query, snapshot
 from orchestra.supervise.supervisor import Supervisor
+
+sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
+from harness import free_port  # noqa: E402
 
 pytestmark = pytest.mark.timeout(60)
 
@@ -38,12 +41,6 @@ if mode == "sleep":
     time.sleep(100)
 sys.exit(int(mode[4:]))
 '''
-
-
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
 
 
 @pytest.fixture
