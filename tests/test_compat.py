@@ -13,6 +13,7 @@ import json
 import os
 import subprocess
 import sys
+import warnings
 
 import pytest
 from conftest import COMPAT
@@ -38,7 +39,11 @@ COMPARE = _compare_module()
 def _jobs(which: str) -> list:
     if COMPARE is None:
         return []
-    return COMPARE.jobs_for(which)
+    # the shared compare.py reads its JSON with json.load(open(...)) and leaves the closing to
+    # the garbage collector; it is shared material, not ours to edit
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ResourceWarning)
+        return COMPARE.jobs_for(which)
 
 
 def _ids(jobs: list) -> list[str]:

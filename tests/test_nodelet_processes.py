@@ -35,6 +35,8 @@ def spawn(master, tmp_path):
         if proc.poll() is None:
             proc.kill()
         proc.wait()
+        if proc.stdout is not None:
+            proc.stdout.close()
 
 
 def publishers(master, topic: str) -> list[str]:
