@@ -5,9 +5,11 @@ import os
 import signal
 import subprocess
 import sys
+import time
 import xmlrpc.client
 from pathlib import Path
 
+import psutil
 import pytest
 
 from orchestra.master import master_is_up
@@ -81,3 +83,32 @@ def test_second_core_on_same_port_refuses_with_clear_message(core):
     assert second.returncode == 1
     assert "already running" in second.stderr and "Traceback" not in second.stderr
     assert master_is_up(uri)  # the first one is untouched
+
+
+@pytest.mark.parametrize("moment", [0.0, 0.05, 0.1])
+def test_ctrl_c_in_cores_first_moments_stops_it_and_its_master(moment):
+    """As for launch: a Ctrl-C while core imports and starts its master is never lost (it
+    was dropped when it landed in an import-lock callback). SIGINT after the process has
+    used ``moment`` s of CPU, twice each; the port must be free afterwards."""
+    for _ in range(2):
+        port = free_port()
+        env = {k: v for k, v in os.environ.items() if k not in ("ROS_IP", "ROS_HOSTNAME")}
+        proc = subprocess.Popen([sys.executable, "-m", "orchestra", "core", "-p", str(port),
+                                 "--no-rosout"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                text=True, env=env)
+        while _cpu_seconds(proc.pid) < moment and proc.poll() is None:
+            time.sleep(0.005)
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=30)
+        # -SIGINT: before Python's own handler existed; 130: during the imports; 0: stopped
+        assert proc.returncode in (-signal.SIGINT, 130, 0), err
+        assert "Traceback" not in err and "Exception ignored" not in err, err
+        assert not master_is_up(f"http://127.0.0.1:{port}/", timeout=0.5)
+
+
+def _cpu_seconds(pid: int) -> float:
+    try:
+        times = psutil.Process(pid).cpu_times()
+    except psutil.NoSuchProcess:
+        return float("inf")
+    return times.user + times.system

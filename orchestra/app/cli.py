@@ -328,6 +328,9 @@ def _launch_core(ctx: click.Context, words: tuple[str, ...], run_opts: dict[str,
               help="Do not start the /rosout node (log aggregation on /rosout_agg).")
 def core(port: int | None, host: str | None, no_rosout: bool) -> None:
     """Run a ROS master, parameter server and the rosout node until interrupted."""
+    from orchestra.supervise import stop_signals
+
+    stop_signals.record()   # as launch: a Ctrl-C while the master starts is an orderly stop
     from orchestra.app.core import serve_core_until_stopped
 
     code = serve_core_until_stopped(port, host, not no_rosout, out=click.echo,
