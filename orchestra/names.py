@@ -57,6 +57,8 @@ def canonicalize(name: str) -> str:
     """Drop empty segments and the trailing slash (``//a//b/`` -> ``/a/b``)."""
     if not name or name == SEP:
         return name
+    if name[-1] != SEP and "//" not in name:
+        return name  # already canonical: the usual case
     parts = [p for p in name.split(SEP) if p]
     if name[0] == SEP:
         return SEP + SEP.join(parts)

@@ -11,9 +11,9 @@ real launch files depend on them:
 - an arg with ``value`` is fixed (redeclaring or overriding it is an error); one with
   ``default`` takes the value given from outside when there is one;
 - a remap in a child scope replaces the inherited remap with the same ``from``;
-- ``~private`` params are kept in a list shared with child scopes (a group copies it): every
-  later ``<node>`` in that scope receives them. As in roslaunch, a child created while that list
-  is still empty gets a list of its own.
+- ``~private`` params are kept in an ordered mapping shared with child scopes (a group copies
+  it): every later ``<node>`` in that scope receives them. As in roslaunch, a child created
+  while it is still empty gets one of its own.
 """
 from __future__ import annotations
 
@@ -34,7 +34,7 @@ class Scope:
                  "include_stack", "pending_filename")
 
     def __init__(self, ns: str, filename: str | None, parent: Scope | None = None,
-                 params: list[tuple[str, Any]] | None = None,
+                 params: dict[str, Any] | None = None,
                  env_args: list[tuple[str, str]] | None = None,
                  args: dict[str, str] | None = None,
                  arg_names: list[str] | None = None,
@@ -45,7 +45,7 @@ class Scope:
         self.ns = make_global_ns(ns or "/")
         self.filename = filename
         self.remaps: list[tuple[str, str]] = []
-        self.params = params if params else []
+        self.params = params if params else {}
         self.env_args = env_args if env_args is not None else []
         self.args = args if args is not None else {}
         self.arg_names = arg_names if arg_names is not None else []
@@ -88,9 +88,10 @@ class Scope:
 
     # ------------------------------------------------------------------ params
     def add_param(self, key: str, value: Any) -> None:
-        """A ``~param``: later nodes in this scope get it (same key: last one wins)."""
-        self.params[:] = [p for p in self.params if p[0] != key]
-        self.params.append((key, value))
+        """A ``~param``: later nodes in this scope get it (same key: last one wins, and
+        moves to the end)."""
+        self.params.pop(key, None)
+        self.params[key] = value
 
     # ------------------------------------------------------------------ remaps
     def add_remap(self, src: str, dst: str) -> None:
@@ -105,12 +106,20 @@ class Scope:
         self.remaps.append((src, dst))
 
     def remap_args(self) -> list[tuple[str, str]]:
-        """Effective remaps: inherited ones not overridden here, then this scope's own."""
-        if self.parent is None:
-            return list(self.remaps)
-        own = {r[0] for r in self.remaps}
-        inherited = [r for r in self.parent.remap_args() if r[0] not in own]
-        return inherited + self.remaps
+        """Effective remaps: inherited ones not overridden here, then this scope's own.
+
+        Walks up the chain once; most scopes (deep includes and groups) add none."""
+        chain: list[list[tuple[str, str]]] = []
+        scope: Scope | None = self
+        while scope is not None:
+            if scope.remaps:
+                chain.append(scope.remaps)
+            scope = scope.parent
+        effective: list[tuple[str, str]] = []
+        for remaps in reversed(chain):  # outermost first
+            own = {r[0] for r in remaps}
+            effective = [r for r in effective if r[0] not in own] + remaps
+        return effective
 
     # ------------------------------------------------------------------ args
     def add_arg(self, name: str, default: str | None = None, value: str | None = None) -> None:

@@ -291,7 +291,7 @@ class Interpreter:
             return None
         self._check_attrs(entity)
         child = self._ns_and_clear_params(entity, scope)
-        child.params = list(child.params)
+        child.params = dict(child.params)
         return self._children(entity.children, child, default_machine)
 
     # ---------------------------------------------------------------- arg
@@ -573,7 +573,7 @@ class Interpreter:
             param_scope = child.child(name)
         except ScopeError as exc:
             raise self._error(entity, str(exc), "name") from None
-        param_scope.params = []
+        param_scope.params = {}
         pkg, node_type = self._req(entity, scope, "pkg", "type")
         machine, args, output, respawn, respawn_delay, cwd, launch_prefix, required = \
             self._opt(entity, scope, "machine", "args", "output", "respawn", "respawn_delay",
@@ -606,7 +606,7 @@ class Interpreter:
             elif tag == "env":
                 self._env(sub, env_scope)
 
-        for key, value in [*scope.params, *param_scope.params]:
+        for key, value in [*scope.params.items(), *param_scope.params.items()]:
             if is_private(key):
                 key = key[1:]
             self._set_param(param_scope.ns + key, value)

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+from functools import cached_property, lru_cache
 from types import MappingProxyType
 
 from orchestra.errors import Location, OrchestraError, clip
@@ -135,15 +136,16 @@ class TagRule:
     # <param> there), but not those of a <launch> or <group> body
     fold_children: bool = False
 
-    @property
+    # derived from ``attributes`` once, on first use: every element of every file asks
+    @cached_property
     def allowed(self) -> frozenset[str]:
         return frozenset(self.attributes)
 
-    @property
+    @cached_property
     def required(self) -> tuple[str, ...]:
         return tuple(name for name, attr in self.attributes.items() if attr.required)
 
-    @property
+    @cached_property
     def forbidden(self) -> tuple[str, ...]:
         return tuple(name for name, attr in self.attributes.items() if attr.forbidden)
 
@@ -235,10 +237,15 @@ def attribute(tag: str, name: str) -> Attr | None:
     return found.attributes.get(name) if found is not None else None
 
 
+@lru_cache(maxsize=4096)
 def parse(tag: str, name: str, text: str) -> object:
     """``text`` (already resolved) read as the kind the table gives ``tag``'s ``name``;
     ValueError says why it is not one. Unknown attributes are plain text; None for a blank
-    value that means "not written"."""
+    value that means "not written".
+
+    Kept per text: the table is fixed, a kind's parse depends on the text alone and gives
+    an immutable value, and launch files repeat the same few values (``type``, ``output``,
+    ``respawn``...) on every element."""
     attr = attribute(tag, name)
     if attr is None:
         return text

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import bisect
 import re
-from collections.abc import Iterator
 
 from lxml import etree
 
@@ -55,27 +54,40 @@ _ATTRIBUTE = re.compile(r"\s+([^\s=/>]+)\s*=\s*(?:\"[^\"]*\"|'[^']*')")
 
 
 class _Document:
-    """The text of one document and the offset of each start tag, in document order; line
-    starts and attribute offsets are computed only when a position is asked for (an error,
-    ``orchestra check``): most elements of most files are never asked."""
+    """The text of one document and, once a position is asked for (an error, ``orchestra
+    check``), the offset of each start tag in document order and the line starts: most
+    elements of most files are never asked, so a load never scans the text."""
 
-    def __init__(self, text: str, filename: str):
-        self.text = text
+    def __init__(self, data: bytes, filename: str, elements: int):
+        self.data = data
         self.filename = filename
-        self.tags = [m.start() for m in _MARKUP.finditer(text) if m.group(1) is not None]
+        self.elements = elements  # element count lxml saw: the scan must find as many
+        self._text: str | None = None
+        self._tags: list[int] | None = None
         self._line_starts: list[int] | None = None
 
+    def tags(self) -> list[int] | None:
+        """Start tag offsets in document order; None when the scan does not see the
+        elements lxml saw (an encoding or construct it does not follow: lines only)."""
+        if self._tags is None:
+            self._text = _decode(self.data)
+            self._tags = [m.start() for m in _MARKUP.finditer(self._text)
+                          if m.group(1) is not None]
+        return self._tags if len(self._tags) == self.elements else None
+
     def location(self, offset: int) -> Location:
+        assert self._text is not None  # offsets come from tags()
         if self._line_starts is None:
-            self._line_starts = [0] + [m.end() for m in re.finditer("\n", self.text)]
+            self._line_starts = [0] + [m.end() for m in re.finditer("\n", self._text)]
         row = bisect.bisect_right(self._line_starts, offset) - 1
         return Location(self.filename, row + 1, offset - self._line_starts[row] + 1)
 
     def attribute_offset(self, tag_offset: int, name: str) -> int | None:
-        match = _TAG_NAME.match(self.text, tag_offset)
+        assert self._text is not None
+        match = _TAG_NAME.match(self._text, tag_offset)
         pos = match.end() if match else tag_offset
         while True:
-            attr = _ATTRIBUTE.match(self.text, pos)
+            attr = _ATTRIBUTE.match(self._text, pos)
             if attr is None:
                 return None
             if attr.group(1) == name:
@@ -84,19 +96,29 @@ class _Document:
 
 
 class _ElementPositions:
-    """``SourcePositions`` of one XML element."""
+    """``SourcePositions`` of the ``index``-th element of a document; ``line`` (lxml's
+    location of it) stands in when the document's scan cannot place it."""
 
-    __slots__ = ("_document", "_offset")
+    __slots__ = ("_document", "_index", "_line")
 
-    def __init__(self, document: _Document, offset: int):
+    def __init__(self, document: _Document, index: int, line: Location):
         self._document = document
-        self._offset = offset
+        self._index = index
+        self._line = line
+
+    def _offset(self) -> int | None:
+        tags = self._document.tags()
+        return tags[self._index] if tags is not None else None
 
     def start(self) -> Location:
-        return self._document.location(self._offset)
+        offset = self._offset()
+        return self._line if offset is None else self._document.location(offset)
 
     def attribute(self, name: str) -> Location | None:
-        offset = self._document.attribute_offset(self._offset, name)
+        tag_offset = self._offset()
+        if tag_offset is None:
+            return None
+        offset = self._document.attribute_offset(tag_offset, name)
         return self._document.location(offset) if offset is not None else None
 
 
@@ -107,40 +129,95 @@ def _decode(data: bytes) -> str:
         return data.decode("latin-1")  # positions of ASCII markup stay right
 
 
-def _wrap(element: etree._Element, filename: str, document: _Document | None = None,
-          offsets: Iterator[int] | None = None) -> Entity:
-    positions = None
-    if document is not None and offsets is not None:
-        positions = _ElementPositions(document, next(offsets))
-    children = []
-    pieces = [element.text] if element.text else []
-    for child in element:
-        if isinstance(child.tag, str):
-            children.append(_wrap(child, filename, document, offsets))
-        if child.tail:
-            pieces.append(child.tail)
-    attributes = dict(element.attrib)
-    if any(k[0] == "{" for k in attributes):
-        attributes = {_qualified(element, k): v for k, v in attributes.items()}
-    tag = element.tag
-    if tag[0] == "{":
-        tag = _qualified(element, tag)
-    return Entity(tag=tag, attributes=attributes, children=children,
-                  text="".join(pieces) or None,
-                  location=Location(filename, element.sourceline), positions=positions)
+# Documents without namespaces (nearly all) skip the spelling of namespaced names per
+# element. A name is only in a namespace under an ``xmlns`` declaration or with the
+# predeclared ``xml:`` prefix, both written literally (names hold no references), so the
+# bytes of a document in an ASCII-compatible encoding tell; others (UTF-16/32, EBCDIC)
+# ask libxml2.
+_HAS_NAMESPACED_NAME = "boolean(//*[namespace-uri()!=''] | //@*[namespace-uri()!=''])"
+
+
+def _namespaced(tree: etree._Element, data: bytes | None) -> bool:
+    if data is not None:
+        head = data[3:64] if data.startswith(b"\xef\xbb\xbf") else data[:64]
+        head = head.lstrip(b" \t\r\n")
+        if head[:1] == b"<" and head[1:2] != b"\x00":
+            return b"xmlns" in data or b"xml:" in data
+    return bool(tree.xpath(_HAS_NAMESPACED_NAME))
+
+
+class _Walk:
+    """One pass over a parsed document's elements, in document order, building Entities.
+
+    Each element's attributes, text pieces and line are read once (lxml's property access
+    is most of the cost); positions are only recorded as the element's index, resolved by
+    ``_Document`` when asked for."""
+
+    def __init__(self, filename: str, document: _Document | None, namespaced: bool):
+        self.filename = filename
+        self.document = document
+        self.namespaced = namespaced
+        self.count = 0      # elements visited, the index of the next one
+        self.launches = 0   # <launch> elements among them
+
+    def entity(self, element: etree._Element) -> Entity:
+        index = self.count
+        self.count = index + 1
+        tag = element.tag
+        if tag == "launch":
+            self.launches += 1
+        children = []
+        text = element.text
+        pieces = None
+        for child in element:
+            if child.tag.__class__ is str:
+                children.append(self.entity(child))
+            tail = child.tail
+            if tail:
+                if pieces is None:
+                    pieces = [text] if text else []
+                pieces.append(tail)
+        if pieces is not None:
+            text = "".join(pieces)
+        attributes = dict(element.items())
+        if self.namespaced:
+            if any(k[0] == "{" for k in attributes):
+                attributes = {_qualified(element, k): v for k, v in attributes.items()}
+            if tag[0] == "{":
+                tag = _qualified(element, tag)
+        location = Location(self.filename, element.sourceline)
+        positions = None
+        if self.document is not None:
+            positions = _ElementPositions(self.document, index, location)
+        return Entity(tag, attributes, children, text or None, location, positions)
 
 
 def _root(tree: etree._Element, filename: str, data: bytes | None = None) -> Entity:
-    elements = [el for el in tree.iter() if isinstance(el.tag, str)]
-    launches = [i for i, el in enumerate(elements) if el.tag == "launch"]
-    if len(launches) != 1:
-        raise LaunchSyntaxError("invalid roslaunch XML: there must be exactly one <launch> "
-                                f"element (found {len(launches)})", Location(filename, 1))
-    document = _Document(_decode(data), filename) if data is not None else None
-    if document is not None and len(document.tags) != len(elements):
-        document = None  # an encoding or construct the scan does not follow: lines only
-    offsets = iter(document.tags[launches[0]:]) if document is not None else None
-    return _wrap(elements[launches[0]], filename, document, offsets)
+    namespaced = _namespaced(tree, data)
+    if tree.tag == "launch":
+        # the usual document: the walk from the root sees every element
+        start, elements = tree, None
+    else:
+        found = [el for el in tree.iter() if isinstance(el.tag, str)]
+        launches = [i for i, el in enumerate(found) if el.tag == "launch"]
+        if len(launches) != 1:
+            raise _launch_count_error(len(launches), filename)
+        start, elements = found[launches[0]], len(found)
+    document = _Document(data, filename, elements or 0) if data is not None else None
+    walk = _Walk(filename, document, namespaced)
+    if elements is not None:
+        walk.count = launches[0]
+    root = walk.entity(start)
+    if walk.launches != 1:
+        raise _launch_count_error(walk.launches, filename)
+    if document is not None and elements is None:
+        document.elements = walk.count
+    return root
+
+
+def _launch_count_error(found: int, filename: str) -> LaunchSyntaxError:
+    return LaunchSyntaxError("invalid roslaunch XML: there must be exactly one <launch> "
+                             f"element (found {found})", Location(filename, 1))
 
 
 def _syntax_error(exc: etree.XMLSyntaxError, filename: str) -> LaunchSyntaxError:
