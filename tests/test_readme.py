@@ -7,7 +7,7 @@ from pathlib import Path
 import click
 import pytest
 
-from orchestra.cli import cli
+from orchestra.commands import cli
 
 README = (Path(__file__).resolve().parent.parent / "README.md").read_text(encoding="utf-8")
 CTX = click.Context(cli)

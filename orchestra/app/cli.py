@@ -16,6 +16,7 @@ from typing import Any
 
 import click
 
+from orchestra.app.launch_output import OUTPUT_OPTIONS, write_outputs
 from orchestra.completion import complete_launch_words
 from orchestra.errors import OrchestraError
 
@@ -182,31 +183,6 @@ def serve_plan(plan: Any, options: Any, cli: dict[str, Any] | None = None) -> in
     return report.exit_code
 
 
-def _dump_json(plan: Any) -> str:
-    import json
-
-    from orchestra.launch.interpreter import binary_to_json
-    from orchestra.supervise.command import exec_table
-
-    doc = plan.to_json()
-    doc["exec"] = exec_table(plan)
-    return json.dumps(doc, indent=1, default=binary_to_json)
-
-
-def _node_args(plan: Any, name: str) -> str:
-    import shlex
-
-    from orchestra.launch.load import find_node
-    from orchestra.supervise.command import exec_table
-
-    node = find_node(plan, name)
-    entry = exec_table(plan, include_tests=True).get(node.full_name)
-    if entry is None:
-        raise OrchestraError(f"no command line for node [{node.full_name}]")
-    env = [f"{k}={shlex.quote(v)}" for k, v in entry["env"].items()]
-    return " ".join([*env, *(shlex.quote(a) for a in entry["argv"])])
-
-
 def launch_words(words: tuple[str, ...], command: str) -> tuple[list[str], dict[str, str]]:
     """Files and args of ``orchestra COMMAND [PKG] FILE [name:=value ...]``."""
     from orchestra.launch.load import split_words
@@ -217,31 +193,30 @@ def launch_words(words: tuple[str, ...], command: str) -> tuple[list[str], dict[
     return split_words(words)
 
 
+def output_options(func: Callable[..., Any]) -> Callable[..., Any]:
+    """Decorator adding the print-and-exit options of ``orchestra launch``, built from their
+    one definition (``launch_output.OUTPUT_OPTIONS``, which also reads them without click)."""
+    for option in reversed(OUTPUT_OPTIONS):
+        kind: dict[str, Any] = ({"is_flag": True} if option.metavar is None
+                                else {"metavar": option.metavar})
+        func = click.option(option.flag, option.dest, help=option.help, **kind)(func)
+    return func
+
+
 @click.command(context_settings={"help_option_names": ["-h", "--help"]})
 @click.argument("words", nargs=-1, shell_complete=complete_launch_words)
-@click.option("--dump-plan", is_flag=True, help="Print the resolved plan as JSON and exit.")
-@click.option("--dump-params", is_flag=True, help="Print the parameters as YAML and exit.")
-@click.option("--nodes", is_flag=True, help="List the nodes' full names and exit.")
-@click.option("--args", "node_args", metavar="NODE", help="Print NODE's command line and exit.")
-@click.option("--files", is_flag=True, help="List the launch files read and exit.")
-@click.option("--find-node", metavar="NODE", help="Print the file declaring NODE and exit.")
-@click.option("--ros-args", is_flag=True, help="Show the launch file's <arg>s and exit.")
-@click.option("--no-exec", is_flag=True,
-              help="Do not run command= params; record them as {__command__: cmd}.")
+@output_options
 @click.option("--core", "core_only", is_flag=True,
               help="Run the core only (master, parameter server, rosout), like roscore.")
 @run_options
 @click.pass_context
-def launch(ctx: click.Context, words: tuple[str, ...], dump_plan: bool, dump_params: bool,
-           nodes: bool, node_args: str | None, files: bool, find_node: str | None,
-           ros_args: bool, no_exec: bool, core_only: bool, **run_opts: Any) -> None:
+def launch(ctx: click.Context, words: tuple[str, ...], core_only: bool, **options: Any) -> None:
     """Resolve and run a roslaunch file: orchestra launch [PKG] FILE [name:=value ...]."""
     from orchestra.supervise import stop_signals
 
     stop_signals.record()   # first: a Ctrl-C from here on is an orderly stop, never lost
-    from orchestra.launch.load import find_node as find_declared
-    from orchestra.launch.load import interpret, ros_args_text
-
+    modes = {o.dest: options.pop(o.dest) for o in OUTPUT_OPTIONS}
+    run_opts = options
     cli_only = {k: run_opts.pop(k) for k in _CLI_ONLY}
     if cli_only.get("child_name") or cli_only.get("server_uri"):
         raise OrchestraError("-c/--child and -u/--server_uri run roslaunch as the child of a "
@@ -251,45 +226,16 @@ def launch(ctx: click.Context, words: tuple[str, ...], dump_plan: bool, dump_par
         _launch_core(ctx, words, run_opts, cli_only)
         return
     paths, args = launch_words(words, "launch")
-    if ros_args:
-        click.echo(ros_args_text(paths, args))
+    if write_outputs(paths, args, modes):
         return
-    dumping = dump_plan or dump_params or nodes or bool(node_args) or files or bool(find_node)
-    # like roslaunch, everything but the two dumps loads roscore.xml's params first; when the
-    # plan is going to run, command= params always run (--no-exec only shapes the dumps)
-    interp = interpret(paths, args, no_exec=no_exec and dumping,
-                       roscore=not (dump_plan or dump_params))
-    plan = interp.plan()
-    if dump_plan:
-        click.echo(_dump_json(plan))
-    elif dump_params:
-        from orchestra.params.dump_launch import dump_launch_params
+    from orchestra.launch.load import interpret, undeclared_args
 
-        # roslaunch prints the YAML document (which ends in a newline) with print(), so its
-        # output ends in an empty line; scripts diff the two, so match it byte for byte
-        click.echo(dump_launch_params(dict(plan.params)))
-    elif nodes:
-        names = [n.full_name for n in (*plan.nodes, *plan.tests) if n.name]
-        if names:
-            click.echo("\n".join(names))
-    elif node_args:
-        click.echo(_node_args(plan, node_args))
-    elif files:
-        seen: list[str] = []
-        for path in plan.files_loaded:
-            full = os.path.abspath(path)
-            if full not in seen:
-                seen.append(full)
-        click.echo("\n".join(seen))
-    elif find_node:
-        node = find_declared(plan, find_node)
-        click.echo(node.filename or "")
-    else:
-        from orchestra.launch.load import undeclared_args
-
-        for warning in undeclared_args(paths, args):
-            echo_err(f"orchestra: {warning}")
-        sys.exit(serve_plan(plan, options_from_cli(run_opts), cli_only))
+    # a run loads roscore.xml's params first, as roslaunch does, and always runs command=
+    # params (--no-exec only shapes the dumps)
+    plan = interpret(paths, args, no_exec=False, roscore=True).plan()
+    for warning in undeclared_args(paths, args):
+        echo_err(f"orchestra: {warning}")
+    sys.exit(serve_plan(plan, options_from_cli(run_opts), cli_only))
 
 
 # roslaunch's flags that the CLI handles around a run (not RunOptions of the run itself)
