@@ -9,16 +9,20 @@ from __future__ import annotations
 import urllib.parse
 from collections.abc import Sequence
 from dataclasses import replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from orchestra.errors import OrchestraError
 from orchestra.launch.plan import LaunchPlan, Node
-from orchestra.remote.locality import UnresolvableAddress, is_local_machine
-from orchestra.remote.session import RemoteSession
 from orchestra.rosdirs import ros_home
 from orchestra.supervise.process import ProcessSpec
 from orchestra.supervise.reaper import Watchdog
 from orchestra.supervise.specs import SpecOptions, build_specs, node_location
+
+if TYPE_CHECKING:
+    from orchestra.remote.session import RemoteSession
+
+# orchestra/remote/ (ssh sessions, the agent, interface addresses) is imported only by a
+# plan that names a <machine>: a local launch does not pay its import before its nodes start
 
 
 def split_remote(plan: LaunchPlan, nodes: Sequence[Node]) -> tuple[list[Node], list[Node]]:
@@ -32,6 +36,8 @@ def split_remote(plan: LaunchPlan, nodes: Sequence[Node]) -> tuple[list[Node], l
             here.append(node)
             continue
         if machine.name not in verdicts:
+            from orchestra.remote.locality import UnresolvableAddress, is_local_machine
+
             try:
                 verdicts[machine.name] = is_local_machine(machine.address, machine.user)
             except UnresolvableAddress:
@@ -44,6 +50,8 @@ def split_remote(plan: LaunchPlan, nodes: Sequence[Node]) -> tuple[list[Node], l
 
 def open_remote(plan: LaunchPlan, remote: list[Node], watchdog: Watchdog) -> RemoteSession:
     """Connect and check every remote machine of the run (orchestra/remote/session.py)."""
+    from orchestra.remote.session import RemoteSession
+
     session = RemoteSession(dict(plan.machines), remote, mark=watchdog.mark,
                             watch=watchdog.watch)
     session.open()

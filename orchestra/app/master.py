@@ -30,7 +30,6 @@ from orchestra.master import (
     upload_params,
 )
 from orchestra.master.client import MasterUnreachable
-from orchestra.params.dump import dump_yaml
 from orchestra.rpc import TRANSPORT_ERRORS, call, proxy
 from orchestra.supervise import stop_signals
 
@@ -161,6 +160,8 @@ def run_param_actions(plan: LaunchPlan, uri: str, report: Report) -> None:
             if action.command == "delete":
                 report(f"rosparam delete {action.param}")
                 continue
+            from orchestra.params.dump import dump_yaml  # (yaml: only when dumping)
+
             try:
                 with open(action.file or "", "w", encoding="utf-8") as fh:
                     fh.write(dump_yaml(value))

@@ -23,7 +23,7 @@ import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from orchestra.app.machines import master_warnings, open_remote, remote_specs, split_remote
 from orchestra.app.master import (
@@ -38,10 +38,8 @@ from orchestra.app.master import (
 )
 from orchestra.app.options import RunOptions
 from orchestra.launch.plan import LaunchPlan, Node
-from orchestra.remote.session import RemoteSession
 from orchestra.rpc import TRANSPORT_ERRORS, proxy
 from orchestra.supervise import control
-from orchestra.supervise.interactive import InteractiveView, terminal_ok
 from orchestra.supervise.output import Screen, prepare_run_log_dir
 from orchestra.supervise.process import ManagedProcess, State
 from orchestra.supervise.reaper import Watchdog
@@ -50,6 +48,9 @@ from orchestra.supervise.rpc import LaunchRPCServer, uris_param
 from orchestra.supervise.specs import check_unique_names, resolve_executables, run_specs
 from orchestra.supervise.status import LiveView, ProcessStats, StatusServer, runtime_dir, snapshot
 from orchestra.supervise.supervisor import RunResult, Supervisor
+
+if TYPE_CHECKING:
+    from orchestra.remote.session import RemoteSession
 
 logger = logging.getLogger(__name__)
 
@@ -397,6 +398,8 @@ class LaunchRun:
             self._closers.append(lambda: delete_param(master.uri, uris_key))
         opts = self.options
         view_on = opts.status_view if opts.status_view is not None else screen.out.isatty()
+        if opts.ui:     # only then: the interactive view (and rich) is not imported
+            from orchestra.supervise.interactive import InteractiveView, terminal_ok
         if opts.ui and terminal_ok(sys.stdin, screen.out):
             ui = InteractiveView(supervisor.loop, supervisor, screen, make_snapshot,
                                  sys.stdin.fileno())

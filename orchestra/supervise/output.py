@@ -186,10 +186,15 @@ class NodeOutput:
             for stream, suffix in (("out", "stdout"), ("err", "stderr")):
                 path = os.path.join(log_dir, f"{log_name}-{suffix}.log")
                 self.files[stream] = RotatingFile(path, max_bytes, backups)
-                try:
-                    self.files[stream].touch()   # exists from the start, like roslaunch's
-                except OSError:
-                    pass
+
+    def started(self) -> None:
+        """The node started: its log files exist from now on, like roslaunch's (created
+        here, not at construction, so a launch opens them after its nodes are spawned)."""
+        for log in self.files.values():
+            try:
+                log.touch()
+            except OSError:
+                pass
 
     def _to_screen(self, stream: str) -> bool:
         return self.mode != OutputMode.LOG or stream == "err"

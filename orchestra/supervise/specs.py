@@ -54,12 +54,19 @@ def check_unique_names(nodes: Sequence[Node]) -> None:
 
 
 def resolve_executables(nodes: Sequence[Node]) -> dict[str, str]:
-    """Full name -> executable for every node; ALL problems reported before anything starts."""
+    """Full name -> executable for every node; ALL problems reported before anything starts.
+
+    Each (package, type) is looked up once: the lookup walks the package tree, and a launch
+    of many instances of one node type paid that walk per node."""
     found: dict[str, str] = {}
+    paths: dict[tuple[str, str], str] = {}
     errors: list[OrchestraError] = []
     for node in nodes:
+        key = (node.package, node.type)
         try:
-            found[node.full_name] = find_node_executable(node)
+            if key not in paths:
+                paths[key] = find_node_executable(node)
+            found[node.full_name] = paths[key]
         except OrchestraError as exc:
             errors.append(exc)
     if errors:

@@ -56,6 +56,7 @@ from orchestra.supervise.reaper import (
     setpriv_prefix,
     signal_group,
 )
+from orchestra.supervise.spawner import Spawner
 
 logger = logging.getLogger(__name__)
 
@@ -125,6 +126,7 @@ class Supervisor:
         self._pid = os.getpid()
         self.started_at = time.monotonic()
         self._cgroups: dict[str, str] = {}
+        self._spawner = Spawner()
         self._cgroup_problem = (cgroup_unavailable()
                                 if any(s.limits.cpu for s in specs) else None)
 
@@ -137,11 +139,50 @@ class Supervisor:
         raise KeyError(name)
 
     def start_all(self) -> None:
-        """Spawn every process in order; a required one failing to spawn stops everything."""
+        """Spawn every process; a required one failing to spawn stops everything.
+
+        The commands are vetted in order first: a required process that cannot start
+        stops the launch, and nothing after it is spawned (those before it are, and then
+        stopped, as when spawning one by one). Then they are spawned together
+        (``spawner.py``: one by one, each spawn waited for its child to get a CPU) and
+        registered in order, so start order, messages and stop order stay the plan's.
+        Where a spawn runs Python in the child (``preexec_fn``: no setpriv, or rlimits),
+        everything is spawned one by one in this thread.
+        """
+        if self.stopping:
+            return
+        if any(self._preexec(proc.spec) is not None for proc in self.procs):
+            for proc in self.procs:
+                if self.stopping:
+                    break
+                self._spawn(proc)
+            return
+        ready: list[tuple[ManagedProcess, list[str]]] = []
+        refused: tuple[ManagedProcess, OSError] | None = None
         for proc in self.procs:
-            if self.stopping:
-                break
-            self._spawn(proc)
+            try:
+                ready.append((proc, self._command(proc.spec)))
+            except OSError as exc:
+                if proc.spec.required:   # the ones before it start, and are stopped
+                    refused = (proc, exc)
+                    break
+                self._spawn_failed(proc, exc)
+        outcomes = self._spawner.run([functools.partial(self._popen, proc.spec, argv)
+                                      for proc, argv in ready])
+        for (proc, _), outcome in zip(ready, outcomes, strict=True):
+            if isinstance(outcome.error, (OSError, subprocess.SubprocessError)):
+                self._spawn_failed(proc, outcome.error)
+                continue
+            if outcome.error is not None:
+                raise outcome.error
+            assert outcome.value is not None
+            if proc.state != State.STARTING:   # marked 'never started' by a stop meanwhile
+                proc.transition(State.STARTING, "spawned while the launch was stopping")
+            self._started(proc, outcome.value)
+            if self.stopping:   # a required one failed to spawn meanwhile: stop this one too
+                self._signal_stop(proc, self._stop_reason, [])
+        if refused is not None:
+            self._spawn_failed(*refused)
 
     def request_stop(self, reason: str = "stop requested", exit_code: int = 0) -> None:
         """Begin the orderly stop of everything (idempotent; the first reason is kept)."""
@@ -162,13 +203,8 @@ class Supervisor:
                 proc.transition(State.EXITED, "never started")
         trees = descendants(self._children[p.spec.name].popen.pid for p in running)
         for proc in sorted(running, key=lambda p: p.start_index, reverse=True):
-            child = self._children[proc.spec.name]
-            pid = child.popen.pid
-            child.extra = [d for d in trees.get(pid, ()) if _pgid(d) != pid]
-            proc.transition(State.STOPPING, reason)
-            signal_group(pid, signal.SIGINT, child.extra)
-            self._set_timer(proc, proc.spec.sigint_timeout,
-                            functools.partial(self._escalate, proc, signal.SIGTERM))
+            pid = self._children[proc.spec.name].popen.pid
+            self._signal_stop(proc, reason, [d for d in trees.get(pid, ()) if _pgid(d) != pid])
         self._changed()
 
     def kill_all(self) -> None:
@@ -252,14 +288,20 @@ class Supervisor:
         return f"sent {signal.Signals(signum).name} to {name}"
 
     def _stop_one(self, proc: ManagedProcess, after: State, reason: str) -> None:
-        child = self._children[proc.spec.name]
-        pid = child.popen.pid
-        child.extra = [d for d in descendants([pid]).get(pid, ()) if _pgid(d) != pid]
+        pid = self._children[proc.spec.name].popen.pid
         proc.after_stop = after
+        self._signal_stop(proc, reason,
+                          [d for d in descendants([pid]).get(pid, ()) if _pgid(d) != pid])
+
+    def _signal_stop(self, proc: ManagedProcess, reason: str, extra: list[int]) -> None:
+        """SIGINT to a running process's group and ``extra`` (its descendants outside the
+        group); SIGTERM after its sigint_timeout, then SIGKILL (``_escalate``)."""
+        child = self._children[proc.spec.name]
+        child.extra = extra
         proc.transition(State.STOPPING, reason)
-        signal_group(pid, signal.SIGINT, child.extra)
+        signal_group(child.popen.pid, signal.SIGINT, extra)
         self._set_timer(proc, proc.spec.sigint_timeout,
-                        lambda: self._escalate(proc, signal.SIGTERM))
+                        functools.partial(self._escalate, proc, signal.SIGTERM))
 
     def run(self, install_signals: bool = True,
             before_start: Callable[[], None] | None = None) -> RunResult:
@@ -292,35 +334,53 @@ class Supervisor:
 
     # ------------------------------------------------------------------ spawning
 
-    def _spawn(self, proc: ManagedProcess) -> None:
+    def _spawn(self, proc: ManagedProcess, argv: list[str] | None = None) -> None:
+        """Start ``proc`` now, in this thread (``argv``: its command, already vetted)."""
         spec = proc.spec
         if proc.state in (State.BACKOFF, State.STOPPING):
             proc.transition(State.STARTING, "respawn" if proc.state == State.BACKOFF
                             else "restart")
         proc.after_stop = None
-        argv = list(spec.argv)
-        preexec = _chain(child_setup(self._pid) if self.pdeathsig == "preexec" else None,
-                         rlimit_setup(spec.limits))
         try:
-            os.makedirs(spec.cwd, exist_ok=True)
-            if self.pdeathsig == "setpriv":
-                check_executable(argv[0], spec.env, spec.cwd)
-                argv = [*(setpriv_prefix() or ()), *argv]  # checked at __init__
-            # the child inherits this thread's signal mask through fork and exec
-            held = (signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
-                    if spec.sigint_held else None)
-            try:
-                popen = subprocess.Popen(
-                    argv, cwd=spec.cwd, env={**spec.env, MARK_VARIABLE: self.mark},
-                    stdin=None,  # inherited, as roslaunch
-                    stdout=subprocess.PIPE, stderr=subprocess.PIPE, close_fds=True,
-                    start_new_session=True, preexec_fn=preexec)
-            finally:
-                if held is not None:
-                    signal.pthread_sigmask(signal.SIG_SETMASK, held)
+            popen = self._popen(spec, self._command(spec) if argv is None else argv)
         except (OSError, subprocess.SubprocessError) as exc:
             self._spawn_failed(proc, exc)
             return
+        self._started(proc, popen)
+
+    def _preexec(self, spec: ProcessSpec) -> Callable[[], None] | None:
+        """The Python run in the child between fork and exec, if this spec needs any."""
+        return _chain(child_setup(self._pid) if self.pdeathsig == "preexec" else None,
+                      rlimit_setup(spec.limits))
+
+    def _command(self, spec: ProcessSpec) -> list[str]:
+        """The argv to exec for ``spec``, or the OSError exec would give (checked here
+        because setpriv, not Popen, would meet it); creates the working directory."""
+        argv = list(spec.argv)
+        os.makedirs(spec.cwd, exist_ok=True)
+        if self.pdeathsig == "setpriv":
+            check_executable(argv[0], spec.env, spec.cwd)
+            argv = [*(setpriv_prefix() or ()), *argv]  # checked at __init__
+        return argv
+
+    def _popen(self, spec: ProcessSpec, argv: list[str]) -> subprocess.Popen:
+        """Fork and exec ``argv``; safe in any thread (touches no supervisor state)."""
+        # the child inherits this thread's signal mask through fork and exec
+        held = (signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+                if spec.sigint_held else None)
+        try:
+            return subprocess.Popen(
+                argv, cwd=spec.cwd, env={**spec.env, MARK_VARIABLE: self.mark},
+                stdin=None,  # inherited, as roslaunch
+                stdout=subprocess.PIPE, stderr=subprocess.PIPE, close_fds=True,
+                start_new_session=True, preexec_fn=self._preexec(spec))
+        finally:
+            if held is not None:
+                signal.pthread_sigmask(signal.SIG_SETMASK, held)
+
+    def _started(self, proc: ManagedProcess, popen: subprocess.Popen) -> None:
+        """Watch a freshly spawned process (exit, output) and mark it RUNNING."""
+        spec = proc.spec
         pidfd = _pidfd_open(popen.pid)
         child = _Child(popen, pidfd)
         self._children[spec.name] = child
@@ -332,6 +392,7 @@ class Supervisor:
             threading.Thread(target=self._wait_in_thread, args=(proc, popen), daemon=True,
                              name=f"wait {spec.name}").start()
         output = self.outputs[spec.name]
+        output.started()
         for stream, pipe in (("out", popen.stdout), ("err", popen.stderr)):
             assert pipe is not None  # both are subprocess.PIPE
             fd = pipe.fileno()
@@ -608,6 +669,7 @@ class Supervisor:
             if child.pidfd is not None:
                 os.close(child.pidfd)
         self._children.clear()
+        self._spawner.close()     # only now: a child dies with the thread that spawned it
         self.loop.close()
 
     def _finish(self) -> RunResult:
