@@ -385,12 +385,13 @@ def is_launch_file(path: str, fmt_from: str) -> bool:
         if format_of(path) == YAML:
             return False
         try:
-            with open(path, "rb") as fh:
+            with open(path, "rb") as fh:   # iterparse left open by the early return
                 if not fh.read(512).lstrip().startswith(b"<"):
                     return False
-            for _, element in etree.iterparse(path, events=("start",), recover=True,
-                                              resolve_entities=False, no_network=True):
-                return element.tag == "launch"
+                fh.seek(0)
+                for _, element in etree.iterparse(fh, events=("start",), recover=True,
+                                                  resolve_entities=False, no_network=True):
+                    return element.tag == "launch"
         except (etree.XMLSyntaxError, OSError):
             return False
         return False
