@@ -135,7 +135,9 @@ PROBE = textwrap.dedent('''
         teleop.publish(twist)
         time.sleep(0.1)
     time.sleep(1.0)   # the base's 0.6 s command timeout stops it
-    wait(lambda: seen["agg"] is not None and seen["ekf"] is not None)
+    # an aggregate sent before the base's first diagnostics has its groups only (stale)
+    wait(lambda: seen["agg"] is not None and seen["ekf"] is not None
+         and any(s[0] == "/Power System/Battery" for s in seen["agg"]))
     wait(lambda: seen["active"][-1:] == ["idle"])
     with lock:
         seen["start"] = start
