@@ -16,8 +16,16 @@ CLOCK_MONOTONIC, which every process on the machine shares.
 Against the real ROS 1 rospy (Debian's, run by /usr/bin/python3): the same roles, same
 messages and timing, as rospy->rospy, and mixed (orchestra->rospy, rospy->orchestra); service
 calls/s rospy client->rospy service next to orchestra's. All pairs look each other up through
-the same (orchestra) master, which is not on the measured path. Skipped with a message when
+the same (orchestra) master, which is not on the measured path of topics (it is on a plain
+service call's: each call looks the service up, as rospy's does). Skipped with a message when
 rospy is missing.
+
+Pinning (``--pin split``, the default on a machine with 2+ CPUs): every publisher and client
+runs on CPU 0, every subscriber and service on CPU 1, and this process (the master) on CPU
+1 too, whichever implementation plays the role. Unpinned, a request/reply rate doubles or
+halves with where the scheduler happens to put the two processes (same CPU: a direct switch;
+two CPUs: a cross-CPU wake-up per message), which made persistent service calls bimodal
+(0.4-3.2x from one run to the next). ``--pin none`` leaves placement to the scheduler.
 """
 from __future__ import annotations
 
@@ -135,10 +143,13 @@ def role_sub(kind: str, count: int, burst: int) -> None:
             latencies.append(t - read_stamp(kind, m))
 
     rospy.init_node(f"bench_sub_{kind}", disable_signals=True)
-    rospy.Subscriber("/bench", type(msg), callback, queue_size=burst)
+    rospy.Subscriber("/bench", type(msg), callback, queue_size=burst or 10)
     emit({"ready": True})
     line = sys.stdin.readline()  # "latency done" from the parent
     emit({"latency": summarize(latencies)})
+    if not burst:
+        rospy.signal_shutdown("done")
+        return
     done.wait(float(line.split()[-1]) if line.strip() else 30.0)
     received = len(burst_times) - 1
     span = burst_times[-1] - burst_times[0] if received > 0 else float("nan")
@@ -147,15 +158,14 @@ def role_sub(kind: str, count: int, burst: int) -> None:
     rospy.signal_shutdown("done")
 
 
-def role_pub(kind: str, count: int, burst: int) -> None:
+def role_pub(kind: str, count: int, burst: int, gap: float) -> None:
     rospy = node_api()
     msg = make_message(kind)
     rospy.init_node(f"bench_pub_{kind}", disable_signals=True)
-    pub = rospy.Publisher("/bench", type(msg), queue_size=burst)
+    pub = rospy.Publisher("/bench", type(msg), queue_size=burst or 10)
     while pub.get_num_connections() < 1:
         time.sleep(0.01)
     time.sleep(0.2)
-    gap = 0.002 if kind == "twist" else 0.01
     for _ in range(count):
         stamp(kind, msg, now())
         pub.publish(msg)
@@ -163,6 +173,9 @@ def role_pub(kind: str, count: int, burst: int) -> None:
     time.sleep(0.3)
     emit({"latency_sent": count})
     sys.stdin.readline()  # go for the burst
+    if not burst:
+        rospy.signal_shutdown("done")
+        return
     if kind == "twist":
         msg.angular.z = 1.0
     else:
@@ -247,9 +260,20 @@ def role_raw_server(size: int, count: int, burst: int) -> None:
 
 
 def raw_baseline(size: int, count: int, burst: int, calls: int, gap: float) -> dict:
-    proc = subprocess.Popen([sys.executable, HERE, "--role", "raw_server", "--size", str(size),
-                             "--count", str(count), "--burst", str(burst)],
-                            stdout=subprocess.PIPE, text=True)
+    """The same bytes over a bare socket; this process is the sending side, on the
+    publisher's CPU while it runs."""
+    master_cpus = os.sched_getaffinity(0)
+    if CPUS:
+        os.sched_setaffinity(0, {CPUS["raw_client"]})
+    try:
+        return _raw_baseline(size, count, burst, calls, gap)
+    finally:
+        os.sched_setaffinity(0, master_cpus)
+
+
+def _raw_baseline(size: int, count: int, burst: int, calls: int, gap: float) -> dict:
+    proc = child(dict(os.environ), "raw_server", "--size", str(size), "--count", str(count),
+                 "--burst", str(burst))
     port = json.loads(proc.stdout.readline())["port"]
     sock = socket.create_connection(("127.0.0.1", port))
     sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
@@ -276,7 +300,13 @@ def raw_baseline(size: int, count: int, burst: int, calls: int, gap: float) -> d
 
 # --- driver ---------------------------------------------------------------------------------------
 
-def child(env: dict, *args: str, impl: str = "orchestra") -> subprocess.Popen:
+#: the CPU of each role under ``--pin split`` (None: unpinned); "master" is this process
+CPUS: dict[str, int] | None = None
+SPLIT = {"pub": 0, "client": 0, "raw_client": 0, "sub": 1, "service": 1, "raw_server": 1,
+         "master": 1}
+
+
+def child(env: dict, role: str, *args: str, impl: str = "orchestra") -> subprocess.Popen:
     """A role in a child process: orchestra's interpreter, or the ROS 1 one for rospy."""
     if impl == "rospy":
         import ros1
@@ -284,7 +314,8 @@ def child(env: dict, *args: str, impl: str = "orchestra") -> subprocess.Popen:
         env = ros1.base_env(ROS_MASTER_URI=env["ROS_MASTER_URI"], PYTHONUNBUFFERED="1")
     else:
         python = sys.executable
-    return subprocess.Popen([python, HERE, "--impl", impl, *args], env=env,
+    pin = ["--cpu", str(CPUS[role])] if CPUS else []
+    return subprocess.Popen([python, HERE, "--impl", impl, "--role", role, *pin, *args], env=env,
                             stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
 
 
@@ -303,17 +334,23 @@ def tell(proc: subprocess.Popen, text: str = "") -> None:
     proc.stdin.flush()
 
 
-def bench_topic(env: dict, kind: str, count: int, burst: int, pub_impl: str = "orchestra",
-                sub_impl: str = "orchestra") -> dict:
-    sub = child(env, "--role", "sub", "--kind", kind, "--count", str(count), "--burst", str(burst),
+def bench_topic(env: dict, kind: str, count: int, burst: int, gap: float,
+                pub_impl: str = "orchestra", sub_impl: str = "orchestra") -> dict:
+    """One publisher and one subscriber process: ``count`` messages ``gap`` s apart for
+    latency, then (``burst`` > 0) a burst for throughput."""
+    sub = child(env, "sub", "--kind", kind, "--count", str(count), "--burst", str(burst),
                 impl=sub_impl)
     read(sub, "ready")
-    pub = child(env, "--role", "pub", "--kind", kind, "--count", str(count), "--burst", str(burst),
-                impl=pub_impl)
+    pub = child(env, "pub", "--kind", kind, "--count", str(count), "--burst", str(burst),
+                "--gap", str(gap), impl=pub_impl)
     read(pub, "latency_sent")
     tell(sub, "latency done 20")
     latency = read(sub, "latency")["latency"]
     tell(pub)
+    if not burst:
+        for proc in (pub, sub):
+            proc.wait(15)
+        return {"latency": latency}
     read(pub, "burst_sent")
     throughput = read(sub, "throughput")["throughput"]
     tell(pub)
@@ -334,13 +371,21 @@ def main() -> None:
     parser.add_argument("--impl", default="orchestra", choices=("orchestra", "rospy"),
                         help="(child roles) the node API to use")
     parser.add_argument("--json", action="store_true", help="Print one JSON document.")
+    parser.add_argument("--gap", type=float, default=0.002,
+                        help="(pub role) seconds between latency messages")
+    parser.add_argument("--pin", default="split", choices=("split", "none"),
+                        help="split: publishers/clients on CPU 0, subscribers/services and "
+                             "the master on CPU 1; none: the scheduler decides")
+    parser.add_argument("--cpu", type=int, default=None, help="(child roles) run on this CPU")
     opts = parser.parse_args()
     global IMPL
     IMPL = opts.impl
+    if opts.cpu is not None:
+        os.sched_setaffinity(0, {opts.cpu})  # before any thread exists: all inherit it
     if opts.role == "sub":
         return role_sub(opts.kind, opts.count, opts.burst)
     if opts.role == "pub":
-        return role_pub(opts.kind, opts.count, opts.burst)
+        return role_pub(opts.kind, opts.count, opts.burst, opts.gap)
     if opts.role == "service":
         return role_service()
     if opts.role == "client":
@@ -349,15 +394,19 @@ def main() -> None:
         return role_raw_server(opts.size, opts.count, opts.burst)
 
     scale = 0.25 if opts.quick else 1.0
+    global CPUS
+    if opts.pin == "split" and hasattr(os, "sched_setaffinity") and len(os.sched_getaffinity(0)) >= 2:
+        CPUS = SPLIT
+        os.sched_setaffinity(0, {CPUS["master"]})  # before the master's threads start
     from orchestra.master import start_master
     master = start_master(host="127.0.0.1", port=0)
     env = dict(os.environ, ROS_MASTER_URI=master.uri, PYTHONUNBUFFERED="1")
-    results: dict = {}
+    results: dict = {"pinning": describe_pinning()}
     try:
         plan = {"twist": (int(2000 * scale), int(5000 * scale), 48, 0.002),
                 "image": (int(200 * scale), int(300 * scale), IMAGE_BYTES + 70, 0.01)}
         for kind, (count, burst, size, gap) in plan.items():
-            results[kind] = bench_topic(env, kind, count, burst)
+            results[kind] = bench_topic(env, kind, count, burst, gap)
             results[kind]["baseline"] = raw_baseline(size, count, burst, 10, gap)
         calls = int(opts.calls * scale)
         results["service"] = bench_service(env, calls)
@@ -365,19 +414,24 @@ def main() -> None:
         import ros1
         if ros1.has_modules("rospy", "geometry_msgs.msg", "sensor_msgs.msg", "std_srvs.srv"):
             results["ros1"] = {}
-            for kind, (count, burst, _, _) in plan.items():
+            for kind, (count, burst, _, gap) in plan.items():
                 for pub_impl, sub_impl in PAIRS[1:]:
                     results["ros1"][f"{kind} {pub_impl}->{sub_impl}"] = bench_topic(
-                        env, kind, count, burst, pub_impl, sub_impl)
-            # service pairs interleaved over rounds, best kept (the shared machine's load
-            # swings these by 2x from one run to the next); orchestra->orchestra included
-            for _ in range(1 if opts.quick else 3):
+                        env, kind, count, burst, gap, pub_impl, sub_impl)
+            # Twist at 100 Hz (a robot's cmd_vel): latency only, every pair in each of
+            # ROUNDS interleaved rounds, medians of the rounds' medians and p99s
+            slow = int(SLOW_TWIST_COUNT * scale)
+            for _ in range(ROUNDS):
+                for pub_impl, sub_impl in PAIRS:
+                    got = bench_topic(env, "twist", slow, 0, 0.01, pub_impl, sub_impl)
+                    results["ros1"].setdefault(f"twist100 {pub_impl}->{sub_impl}", []).append(
+                        got["latency"])
+            # service pairs interleaved over ROUNDS rounds, medians kept (the shared
+            # machine's load swings single runs by 2x); orchestra->orchestra included
+            for _ in range(ROUNDS):
                 for cli_impl, svc_impl in PAIRS:
                     got = bench_service(env, calls, svc_impl, cli_impl)
-                    key = f"service {cli_impl}->{svc_impl}"
-                    best = results["ros1"].setdefault(key, dict.fromkeys(got, 0.0))
-                    for k, v in got.items():
-                        best[k] = max(best[k], v)
+                    results["ros1"].setdefault(f"service {cli_impl}->{svc_impl}", []).append(got)
         else:
             ros1.skip("rospy comparisons", "rospy (with geometry_msgs, sensor_msgs, std_srvs)")
     finally:
@@ -406,8 +460,12 @@ def main() -> None:
     print("ratio = how many times slower than the bare-socket baseline (lower is better)")
     if "ros1" in results:
         print_ros1(results, plan)
+    print(results["pinning"])
     print(load_average())
 
+
+ROUNDS = 5  # interleaved rounds of the service and 100 Hz rows (medians of these)
+SLOW_TWIST_COUNT = 600  # messages per 100 Hz latency run (6 s; --quick: a quarter)
 
 PAIRS = [("orchestra", "orchestra"), ("rospy", "rospy"), ("orchestra", "rospy"),
          ("rospy", "orchestra")]
@@ -415,10 +473,10 @@ PAIRS = [("orchestra", "orchestra"), ("rospy", "rospy"), ("orchestra", "rospy"),
 
 def bench_service(env: dict, calls: int, svc_impl: str = "orchestra",
                   cli_impl: str = "orchestra") -> dict:
-    svc = child(env, "--role", "service", impl=svc_impl)
+    svc = child(env, "service", impl=svc_impl)
     try:
         read(svc, "ready")
-        cli = child(env, "--role", "client", "--calls", str(calls), impl=cli_impl)
+        cli = child(env, "client", "--calls", str(calls), impl=cli_impl)
         result = read(cli, "calls_per_s")["calls_per_s"]
         cli.wait(30)
         tell(svc)
@@ -429,6 +487,17 @@ def bench_service(env: dict, calls: int, svc_impl: str = "orchestra",
                 proc.kill()
                 proc.wait()
     return result
+
+
+def describe_pinning() -> str:
+    if not CPUS:
+        return "unpinned (placement left to the scheduler)"
+    return (f"pinned: publishers and clients on CPU {CPUS['pub']}, subscribers, services and "
+            f"the master on CPU {CPUS['sub']}")
+
+
+def median_of(runs: list[dict], key: str) -> float:
+    return statistics.median(r[key] for r in runs)
 
 
 def load_average() -> str:
@@ -459,11 +528,20 @@ def print_ros1(results: dict, plan: dict) -> None:
                 ratio = values[1] / values[0] if better_low else values[0] / values[1]
                 line += f"{ratio:11.1f}x"
             print(line)
+    slow = [results["ros1"][f"twist100 {a}->{b}"] for a, b in PAIRS]
+    for key, name in (("median_us", "latency median (us)"), ("p99_us", "latency p99 (us)")):
+        values = [median_of(runs, key) for runs in slow]
+        print(f"{'Twist 100 Hz ' + name:36.36}" + "".join(f"{v:14.0f}" for v in values)
+              + f"{values[1] / values[0]:11.1f}x")
+    p99 = [median_of(runs, "p99_us") for runs in slow]
+    print(f"{'  p99 mixed pairs vs rospy->rospy':36.36}{'':28}{p99[1] / p99[2]:14.1f}x"
+          f"{p99[1] / p99[3]:13.1f}x   (>= 1.0x: no worse than rospy)")
     svc = [results["ros1"][f"service {a}->{b}"] for a, b in PAIRS]
     for key in ("plain", "persistent"):
-        values = [r[key] for r in svc]
-        print(f"{'service calls/s ' + key + ', best':36.36}"
+        values = [median_of(runs, key) for runs in svc]
+        print(f"{'service calls/s ' + key + ', median':36.36}"
               + "".join(f"{v:14.0f}" for v in values) + f"{values[0] / values[1]:11.1f}x")
+    print(f"(100 Hz and service rows: medians of {ROUNDS} interleaved rounds)")
     print("rospy/orch = how many times orchestra->orchestra beats rospy->rospy (higher: "
           "orchestra better)")
 
