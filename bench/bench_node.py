@@ -187,7 +187,7 @@ def role_pub(kind: str, count: int, burst: int, gap: float) -> None:
     impl = getattr(pub, "_impl", None)
     deadline = now() + 30
     if IMPL == "orchestra":
-        while now() < deadline and any(c.queue for c in impl.connections):
+        while now() < deadline and not all(c.idle() for c in impl.connections):
             time.sleep(0.01)
     # rospy's publish() hands each message to the connection's writer thread; the parent
     # waits for the subscriber's count either way

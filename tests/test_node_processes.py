@@ -244,6 +244,32 @@ def test_service_calls_plain_persistent_probe_and_handler_error(nodes, master, m
     wait_for(lambda: any("refused" in line for line in srv.stderr_lines))
 
 
+def test_a_service_serves_many_connections_open_at_once(nodes, master, monkeypatch):
+    """Each connection has a thread of its own while it lasts: clients that connect and
+    wait before calling (more of them than the server keeps threads waiting in accept)
+    are all answered, in any order."""
+    nodes.start("adder.py", "add").ready()
+    uri = OneShotProxy(master.uri).lookupService("/test", "/add")[2]
+    host, port = tcpros.parse_rosrpc_uri(uri)
+    from orchestra.node.msg import Registry
+    monkeypatch.setenv("ROS_PACKAGE_PATH", nodes.env["ROS_PACKAGE_PATH"])
+    cls = Registry().service_class("test_msgs/AddTwoInts")
+    socks = [tcpros.connect(host, port, timeout=10) for _ in range(12)]
+    try:
+        for sock in socks:
+            sock.settimeout(10)
+            tcpros.write_header(sock, {"callerid": "/test", "service": "/add",
+                                       "md5sum": cls._md5sum, "persistent": "1"})
+            assert "error" not in tcpros.read_header(sock)
+        for i, sock in reversed(list(enumerate(socks))):
+            tcpros.send_message(sock, cls.Request(a=i, b=100).serialize_bytes())
+            ok, body = tcpros.read_service_response(sock)
+            assert ok and cls.Response.deserialize_bytes(body).sum == i + 100
+    finally:
+        for sock in socks:
+            sock.close()
+
+
 def test_service_proxy_from_a_node_process(nodes):
     nodes.start("adder.py", "math/add").ready()
     caller = nodes.start("caller.py", "math/add")

@@ -80,3 +80,30 @@ def test_bus_counters_beyond_32_bits_still_fit_in_xmlrpc():
     assert xmlrpc_int(5) == 5 and isinstance(xmlrpc_int(5), int)
     big = xmlrpc_int(3 * 2**31)
     assert xmlrpc.client.loads(xmlrpc.client.dumps(([big],)))[0][0] == [3 * 2**31]
+
+
+def test_buffered_reader_reads_replies_in_order_whatever_one_recv_brings():
+    import threading
+
+    def send(sock):
+        tcpros.write_header(sock, {"service": "/s"})
+        tcpros.send_service_response(sock, True, b"one")
+        tcpros.send_service_response(sock, False, b"two")
+        tcpros.send_service_response(sock, True, bytes(range(256)) * 1000)  # > one recv
+        tcpros.send_service_response(sock, True, b"")
+
+    a, b = socket.socketpair()
+    with a, b:
+        writer = threading.Thread(target=send, args=(a,))
+        writer.start()
+        reader = tcpros.Reader(b)
+        assert reader.header() == {"service": "/s"}
+        assert reader.service_response() == (True, b"one")
+        assert reader.service_response() == (False, b"two")
+        assert reader.service_response() == (True, bytes(range(256)) * 1000)
+        assert reader.service_response() == (True, b"")
+        writer.join()
+        a.sendall(struct.pack("<I", 10) + b"abc")
+        a.close()
+        with pytest.raises(TransportException, match="closed"):
+            reader.message()

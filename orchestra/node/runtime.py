@@ -58,7 +58,17 @@ def _advertise_host(special: dict[str, str], master_uri: str) -> str:
 
 
 class TcprosServer:
-    """Accepts TCPROS connections and hands each to the topic or service it asks for."""
+    """Accepts TCPROS connections and hands each to the topic or service it asks for.
+
+    Threads take turns at ``accept`` (leader/followers): the thread that accepts a
+    connection serves it itself while another waits for the next one. A thread created
+    per connection (and the hand-off to it) cost about as much as a whole service call on a
+    kept connection, and a plain service call is a connection. ``SPARE`` threads wait in
+    ``accept``; when the last one takes a connection it starts another before serving, so
+    someone is always accepting; a thread done serving goes back to ``accept`` unless
+    ``SPARE`` already wait there, and ends."""
+
+    SPARE = 2
 
     def __init__(self, runtime: NodeRuntime, bind_host: str, advertise_host: str,
                  port: int = 0):
@@ -70,25 +80,41 @@ class TcprosServer:
         self.port = self.sock.getsockname()[1]
         self.host = advertise_host
         self.closed = False
-        self.thread = threading.Thread(target=self._accept_loop, name="tcpros-accept", daemon=True)
+        self._lock = threading.Lock()
+        self._waiting = 0  # threads in (or about to enter) accept
 
     def start(self) -> None:
-        self.thread.start()
+        for _ in range(self.SPARE):
+            self._add_thread()
+
+    def _add_thread(self) -> None:
+        with self._lock:
+            self._waiting += 1
+        threading.Thread(target=self._accept_loop, name="tcpros-accept", daemon=True).start()
 
     def _accept_loop(self) -> None:
-        while not self.closed:
+        while True:
             try:
                 conn, addr = self.sock.accept()
-            except OSError:
+            except OSError:  # closed by stop()
                 return
-            threading.Thread(target=self._handle, args=(conn, addr), daemon=True,
-                             name=f"tcpros-in-{addr[1]}").start()
+            with self._lock:
+                self._waiting -= 1
+                alone = self._waiting == 0
+            if alone and not self.closed:
+                self._add_thread()
+            self._handle(conn, addr)
+            with self._lock:
+                if self.closed or self._waiting >= self.SPARE:
+                    return
+                self._waiting += 1
 
     def _handle(self, conn: socket.socket, addr) -> None:
         conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        reader = tcpros.Reader(conn)
         try:
             conn.settimeout(10.0)
-            header = tcpros.read_header(conn)
+            header = reader.header()
             conn.settimeout(None)
         except (OSError, TransportException) as exc:
             log.debug("bad TCPROS handshake from %s: %s", addr, exc)
@@ -103,7 +129,7 @@ class TcprosServer:
                             f"{header.get('callerid')} asked for unknown service "
                             f"{header['service']}")
                     return
-                server.handle(conn, header)
+                server.handle(conn, reader, header)
             elif "topic" in header:
                 self.rt.topics.handle_subscriber(conn, header)
             else:

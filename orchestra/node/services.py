@@ -77,8 +77,9 @@ class ServiceServer:
                 "type": cls._type, "request_type": cls._request_class._type,
                 "response_type": cls._response_class._type}
 
-    def handle(self, sock: socket.socket, header: dict[str, str]) -> None:
-        """Serve one client connection (runs on the connection's own thread)."""
+    def handle(self, sock: socket.socket, reader: tcpros.Reader, header: dict[str, str]) -> None:
+        """Serve one client connection (runs on the connection's own thread); ``reader``
+        holds whatever the client sent after its header."""
         from orchestra.node.topics import _refuse
 
         caller = header.get("callerid", "?")
@@ -103,7 +104,7 @@ class ServiceServer:
             tcpros.write_header(sock, self.header())
             while not self.closed:
                 try:
-                    data = tcpros.read_message(sock)
+                    data = reader.message()
                 except TransportException:
                     return
                 self._answer(sock, data, caller)
@@ -169,9 +170,25 @@ class Service:
         self._rt.spin()
 
 
-def _open(runtime_name: str, master, name: str, srv_class: type[ServiceDefinition],
-          persistent: bool, probe: bool = False,
-          timeout: float | None = 10.0) -> tuple[socket.socket, dict[str, str]]:
+class _Connection:
+    """A client's connection to a service: the socket, its reader, the server's header."""
+
+    def __init__(self, sock: socket.socket, reader: tcpros.Reader, header: dict[str, str]):
+        self.sock = sock
+        self.reader = reader
+        self.header = header
+
+    def call(self, body: bytes | bytearray) -> tuple[bool, bytes]:
+        tcpros.send_message(self.sock, body)
+        return self.reader.service_response()
+
+    def close(self) -> None:
+        self.sock.close()
+
+
+def _open(master, name: str, hello: bytes, timeout: float | None = 10.0) -> _Connection:
+    """Look ``name`` up (every time, as rospy does: the service may have moved), connect
+    and exchange headers; ``hello`` is our encoded header."""
     try:
         uri = master.call("lookupService", name)
     except MasterError as exc:
@@ -181,22 +198,17 @@ def _open(runtime_name: str, master, name: str, srv_class: type[ServiceDefinitio
         sock = tcpros.connect(host, port, timeout=timeout)
     except OSError as exc:
         raise ServiceException(f"unable to connect to service [{name}] at {uri}: {exc}") from exc
-    fields = {"callerid": runtime_name, "service": name, "md5sum": srv_class._md5sum,
-              "type": srv_class._type}
-    if persistent:
-        fields["persistent"] = "1"
-    if probe:
-        fields["probe"] = "1"
+    reader = tcpros.Reader(sock)
     try:
-        tcpros.write_header(sock, fields)
-        header = tcpros.read_header(sock)
+        sock.sendall(hello)
+        header = reader.header()
     except (OSError, TransportException) as exc:
         sock.close()
         raise ServiceException(f"service [{name}]: connection failed: {exc}") from exc
     if "error" in header:
         sock.close()
         raise ServiceException(f"service [{name}] refused the connection: {header['error']}")
-    return sock, header
+    return _Connection(sock, reader, header)
 
 
 class NoNode:
@@ -241,7 +253,12 @@ class ServiceProxy:
         self.request_class = service_class._request_class
         self.response_class = service_class._response_class
         self.persistent = persistent
-        self._sock: socket.socket | None = None
+        fields = {"callerid": self._rt.name, "service": self.name,
+                  "md5sum": service_class._md5sum, "type": service_class._type}
+        if persistent:
+            fields["persistent"] = "1"
+        self._hello = tcpros.encode_header(fields)
+        self._conn: _Connection | None = None
         self._lock = threading.Lock()
 
     def wait_for_service(self, timeout: float | None = None) -> None:
@@ -260,21 +277,17 @@ class ServiceProxy:
             request = self.request_class(*args, **kwargs)
         body = request.serialize_bytes()
         with self._lock:
-            sock = self._sock
-            if sock is None:
-                sock, _ = _open(self._rt.name, self._rt.master, self.name, self.service_class,
-                                self.persistent)
+            conn = self._conn or _open(self._rt.master, self.name, self._hello)
             try:
-                tcpros.send_message(sock, body)
-                ok, reply = tcpros.read_service_response(sock)
+                ok, reply = conn.call(body)
             except (OSError, TransportException) as exc:
-                sock.close()
-                self._sock = None
+                conn.close()
+                self._conn = None
                 raise ServiceException(f"service [{self.name}]: connection lost: {exc}") from exc
             if self.persistent:
-                self._sock = sock
+                self._conn = conn
             else:
-                sock.close()
+                conn.close()
         if not ok:
             raise ServiceException(f"service [{self.name}] responded with an error: "
                                    f"{reply.decode('utf-8', 'replace')}")
@@ -282,14 +295,14 @@ class ServiceProxy:
 
     def close(self) -> None:
         with self._lock:
-            if self._sock is not None:
-                self._sock.close()
-                self._sock = None
+            if self._conn is not None:
+                self._conn.close()
+                self._conn = None
 
     def __del__(self):
-        sock = getattr(self, "_sock", None)
-        if sock is not None:
-            sock.close()
+        conn = getattr(self, "_conn", None)
+        if conn is not None:
+            conn.close()
 
 
 def wait_for_service(service: str, timeout: float | None = None) -> None:

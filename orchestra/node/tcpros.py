@@ -52,21 +52,64 @@ def recv_exact(sock: socket.socket, size: int) -> bytes:
     if size == 0:
         return b""
     buf = bytearray(size)
-    view = memoryview(buf)
-    got = 0
+    _recv_into_full(sock, memoryview(buf))
+    return bytes(buf)
+
+
+def _recv_into_full(sock: socket.socket, view: memoryview) -> None:
+    got, size = 0, len(view)
     while got < size:
         n = sock.recv_into(view[got:], size - got)
         if n == 0:
             raise TransportException("connection closed by peer")
         got += n
-    return bytes(buf)
+
+
+def _header_size(raw: bytes) -> int:
+    (size,) = _U32.unpack(raw)
+    if size > MAX_HEADER:
+        raise TransportException(f"connection header of {size} bytes refused")
+    return size
+
+
+def _message_size(raw: bytes) -> int:
+    (size,) = _U32.unpack(raw)
+    if size > MAX_MESSAGE:
+        raise TransportException(f"message of {size} bytes refused")
+    return size
+
+
+class _Framing:
+    """The TCPROS read rules over some way of getting the next n bytes (``exact``)."""
+
+    def exact(self, size: int) -> bytes:
+        raise NotImplementedError
+
+    def header(self) -> dict[str, str]:
+        return decode_header(self.exact(_header_size(self.exact(4))))
+
+    def message(self) -> bytes:
+        return self.exact(_message_size(self.exact(4)))
+
+    def service_response(self) -> tuple[bool, bytes]:
+        """(ok, body) of one service reply: body is the response, or the error text."""
+        ok = self.exact(1)
+        return ok == b"\x01", self.message()
+
+
+class ExactReader(_Framing):
+    """Reads exactly what is asked and not a byte more: a publisher may send messages
+    right behind its header, and whoever reads the socket next must get them."""
+
+    def __init__(self, sock: socket.socket):
+        self.sock = sock
+
+    def exact(self, size: int) -> bytes:
+        return recv_exact(self.sock, size)
 
 
 def read_header(sock: socket.socket) -> dict[str, str]:
-    (size,) = _U32.unpack(recv_exact(sock, 4))
-    if size > MAX_HEADER:
-        raise TransportException(f"connection header of {size} bytes refused")
-    return decode_header(recv_exact(sock, size))
+    return ExactReader(sock).header()
 
 
 def write_header(sock: socket.socket, fields: dict[str, str]) -> None:
@@ -74,10 +117,7 @@ def write_header(sock: socket.socket, fields: dict[str, str]) -> None:
 
 
 def read_message(sock: socket.socket) -> bytes:
-    (size,) = _U32.unpack(recv_exact(sock, 4))
-    if size > MAX_MESSAGE:
-        raise TransportException(f"message of {size} bytes refused")
-    return recv_exact(sock, size)
+    return ExactReader(sock).message()
 
 
 def frame(body: bytes | bytearray) -> list[bytes | bytearray]:
@@ -100,9 +140,44 @@ def send_buffers(sock: socket.socket, buffers: list) -> None:
 
 
 def read_service_response(sock: socket.socket) -> tuple[bool, bytes]:
-    """(ok, body) of one service reply: body is the response, or the error text."""
-    ok = recv_exact(sock, 1)
-    return ok == b"\x01", read_message(sock)
+    return ExactReader(sock).service_response()
+
+
+class Reader(_Framing):
+    """Reads one connection through a buffer: a single ``recv`` usually brings a whole
+    header, request or reply (ok byte, length and body together), where reading each part
+    exactly costs a system call apiece. For connections whose every byte is read here
+    (service calls, both ends); a topic subscriber reads its publisher's header with
+    ``read_header`` instead, then the stream in its own loop."""
+
+    CHUNK = 65536
+
+    def __init__(self, sock: socket.socket):
+        self.sock = sock
+        self._data = b""
+        self._pos = 0
+
+    def exact(self, size: int) -> bytes:
+        """The next ``size`` bytes; ``TransportException`` when the peer closes first."""
+        data, pos = self._data, self._pos
+        end = pos + size
+        if end <= len(data):
+            self._pos = end
+            return data[pos:end]
+        have = data[pos:]
+        self._data, self._pos = b"", 0
+        if size - len(have) >= self.CHUNK:  # a big body: straight into its own buffer
+            buf = bytearray(size)
+            buf[:len(have)] = have
+            _recv_into_full(self.sock, memoryview(buf)[len(have):])
+            return bytes(buf)
+        while len(have) < size:
+            chunk = self.sock.recv(self.CHUNK)
+            if not chunk:
+                raise TransportException("connection closed by peer")
+            have += chunk
+        self._data, self._pos = have, size
+        return have[:size]
 
 
 def send_service_response(sock: socket.socket, ok: bool, body: bytes | bytearray) -> None:

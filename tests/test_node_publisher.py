@@ -1,0 +1,55 @@
+"""A publisher's connection to one subscriber, driven over a socket pair (no master, no
+processes): ``publish`` sends a small message itself when the writer thread is idle, and
+whatever the socket does not take at once (a subscriber that stops reading, a big message)
+follows through the writer thread; the subscriber must see every message, whole and in
+order."""
+from __future__ import annotations
+
+import socket
+import struct
+
+import pytest
+
+from orchestra.node import tcpros
+from orchestra.node.msg import get_message_class
+from orchestra.node.topics import OutConnection, Publication
+
+pytestmark = pytest.mark.timeout(60)
+
+STRING = get_message_class("std_msgs/String")
+
+
+def _read_all(sock: socket.socket, count: int) -> list[bytes]:
+    return [tcpros.read_message(sock) for _ in range(count)]
+
+
+def test_messages_arrive_whole_and_in_order_when_the_socket_fills_midway():
+    ours, theirs = socket.socketpair()
+    ours.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, 4096)
+    conn = OutConnection(Publication(None, "/t", STRING, False, None), ours, "/sub", None)
+    conn.thread.start()
+    sizes = [10, 3000, 5000, 10, OutConnection.DIRECT_MAX + 1, 7, 20000, 1] * 5
+    sent = [struct.pack("<I", i) + bytes([i % 251]) * size for i, size in enumerate(sizes)]
+    try:
+        for data in sent:  # nobody reads yet: the socket fills and the queue takes the rest
+            conn.enqueue(data)
+        assert _read_all(theirs, len(sent)) == sent
+        assert conn.messages_sent == len(sent)
+        conn.enqueue(b"after")  # an idle connection again: sent by enqueue itself
+        assert conn.idle() and tcpros.read_message(theirs) == b"after"
+    finally:
+        conn.close()
+        theirs.close()
+
+
+def test_a_small_message_on_an_idle_connection_is_sent_by_publish_itself():
+    ours, theirs = socket.socketpair()
+    conn = OutConnection(Publication(None, "/t", STRING, False, None), ours, "/sub", None)
+    # writer thread not started: only a direct send can deliver
+    try:
+        conn.enqueue(b"now")
+        assert conn.idle()
+        assert tcpros.read_message(theirs) == b"now"
+    finally:
+        conn.close()
+        theirs.close()
