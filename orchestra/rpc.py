@@ -18,7 +18,9 @@ import xmlrpc.client
 from collections.abc import Iterable, Mapping
 from http.client import HTTPConnection, HTTPException
 from typing import Any, cast
+from urllib.parse import urlsplit, urlunsplit
 
+from orchestra import xmlrpc_codec
 from orchestra.errors import OrchestraError
 
 log = logging.getLogger(__name__)
@@ -45,21 +47,30 @@ def master_uri_from_env(environ: Mapping[str, str] | None = None) -> str:
 
 # -- client side ------------------------------------------------------------------------------
 
-class TimeoutTransport(xmlrpc.client.Transport):
-    """An XML-RPC transport whose connections give up after ``timeout`` seconds.
+class Transport(xmlrpc.client.Transport):
+    """xmlrpc.client's HTTP transport (keep-alive, a retry on a reset kept connection),
+    reading answers with ``xmlrpc_codec`` and giving up after ``timeout`` seconds.
 
     xmlrpc.client has no timeout of its own: a peer that accepts and never answers (a
-    stopped node, a wedged master) would block the caller forever.
+    stopped node, a wedged master) would block the caller forever. Its answer reader feeds
+    expat 1 KiB at a time through Python callbacks; a ROS answer is read whole instead.
     """
 
-    def __init__(self, timeout: float):
+    def __init__(self, timeout: float | None = None):
         super().__init__()
         self.timeout = timeout
 
     def make_connection(self, host: Any) -> HTTPConnection:
         conn = super().make_connection(host)
-        conn.timeout = self.timeout
+        if self.timeout is not None:
+            conn.timeout = self.timeout
         return conn
+
+    def parse_response(self, response: Any) -> tuple[Any, ...]:
+        body = response.read()
+        if response.getheader("Content-Encoding", "") == "gzip":
+            body = xmlrpc.client.gzip_decode(body)
+        return xmlrpc_codec.loads(body)[0]
 
 
 def proxy(uri: str, timeout: float | None = None) -> xmlrpc.client.ServerProxy:
@@ -68,8 +79,7 @@ def proxy(uri: str, timeout: float | None = None) -> xmlrpc.client.ServerProxy:
     A proxy keeps one HTTP connection and is not thread-safe: make one per thread (on
     loopback a connect costs tens of microseconds).
     """
-    transport = TimeoutTransport(timeout) if timeout is not None else None
-    return xmlrpc.client.ServerProxy(uri, transport=transport)
+    return xmlrpc.client.ServerProxy(uri, transport=Transport(timeout))
 
 
 def call(uri: str, method: str, *args: Any, timeout: float | None = None) -> Any:
@@ -79,57 +89,71 @@ def call(uri: str, method: str, *args: Any, timeout: float | None = None) -> Any
         return getattr(server, method)(*args)
 
 
+class _Peer:
+    """One kept connection to an XML-RPC server: a ``Transport`` and where to post."""
+
+    def __init__(self, uri: str, timeout: float | None):
+        where = urlsplit(uri)
+        self.host = where.netloc
+        self.handler = urlunsplit(("", "", *where[2:])) or "/RPC2"  # as ServerProxy does
+        self.transport = Transport(timeout)
+
+    def call(self, method: str, args: tuple[Any, ...]) -> Any:
+        result = self.transport.request(self.host, self.handler,
+                                        xmlrpc_codec.dumps_call(method, args))
+        return result[0] if len(result) == 1 else result
+
+
 class _ProxyPool:
-    """Idle XML-RPC proxies by (uri, timeout), lent out to one call at a time.
+    """Idle XML-RPC connections by (uri, timeout), lent out to one call at a time.
 
     A new connection per call costs ~0.6 ms on loopback (connect, and a server thread per
     connection), five times a call on an open keep-alive connection; rospy likewise keeps
-    its proxies. Each proxy is used by one thread at a time (they are not thread-safe); a
-    stale kept-alive connection (peer restarted, idle timeout) is re-opened by
-    xmlrpc.client's transport, which retries once on a reset. A call that fails on the wire
-    drops its proxy.
+    its proxies. Each connection is used by one thread at a time (an HTTP connection carries
+    one call at a time); a stale kept-alive connection (peer restarted, idle timeout) is
+    re-opened by xmlrpc.client's transport, which retries once on a reset. Calls are written
+    and answers read by ``xmlrpc_codec``. A call that fails on the wire drops its connection.
     """
 
     MAX_IDLE = 8  # per (uri, timeout): more concurrent callers than that open their own
 
     def __init__(self) -> None:
         self._lock = threading.Lock()
-        self._idle: dict[tuple[str, float | None], list[xmlrpc.client.ServerProxy]] = {}
+        self._idle: dict[tuple[str, float | None], list[_Peer]] = {}
 
     def call(self, uri: str, method: str, *args: Any, timeout: float | None = None) -> Any:
         key = (uri, timeout)
         with self._lock:
             idle = self._idle.get(key)
-            server = idle.pop() if idle else None
-        if server is None:
-            server = proxy(uri, timeout)
+            peer = idle.pop() if idle else None
+        if peer is None:
+            peer = _Peer(uri, timeout)
         try:
-            result = getattr(server, method)(*args)
+            result = peer.call(method, args)
         except xmlrpc.client.Fault:
-            self._give_back(key, server)
+            self._give_back(key, peer)
             raise
         except BaseException:
-            server("close")()
+            peer.transport.close()
             raise
-        self._give_back(key, server)
+        self._give_back(key, peer)
         return result
 
-    def _give_back(self, key: tuple[str, float | None], server: xmlrpc.client.ServerProxy
-                   ) -> None:
+    def _give_back(self, key: tuple[str, float | None], peer: _Peer) -> None:
         with self._lock:
             idle = self._idle.setdefault(key, [])
             if len(idle) < self.MAX_IDLE:
-                idle.append(server)
+                idle.append(peer)
                 return
-        server("close")()
+        peer.transport.close()
 
     def close(self) -> None:
         """Close every idle connection (at exit, so none is left to the garbage collector)."""
         with self._lock:
-            servers = [s for idle in self._idle.values() for s in idle]
+            peers = [p for idle in self._idle.values() for p in idle]
             self._idle.clear()
-        for server in servers:
-            server("close")()
+        for peer in peers:
+            peer.transport.close()
 
 
 _POOL = _ProxyPool()
@@ -195,8 +219,8 @@ class AnyPathHandler(socketserver.StreamRequestHandler):
     The stdlib's http.server parses every request's headers with the email package and does
     per-request bookkeeping that costs more than the XML-RPC call itself; a ROS call needs
     only the request line, Content-Length (and Content-Encoding, Connection). The body goes to
-    the server's dispatcher (``xmlrpc.client.loads``/``dumps``: expat and the stdlib
-    marshaller), whose faults are answered as XML-RPC faults, as SimpleXMLRPCServer does.
+    the server's dispatcher (``xmlrpc_codec``: the stdlib's reading and writing, faster for
+    the documents ROS sends), whose faults are answered as XML-RPC faults, as SimpleXMLRPCServer does.
     ``protocol_version = "HTTP/1.1"`` keeps connections open between calls (rospy's and
     roscpp's clients reuse them); the default answers one call per connection.
     """
@@ -308,16 +332,14 @@ class Dispatcher:
     def marshaled_dispatch(self, data: bytes) -> bytes:
         """The XML-RPC answer (a result or a fault) to the request body ``data``."""
         try:
-            params, method = xmlrpc.client.loads(data)
+            params, method = xmlrpc_codec.loads(data)
             result = self.dispatch(method or "", params)
-            response = xmlrpc.client.dumps((result,), methodresponse=True,
-                                           allow_none=self.allow_none)
+            return xmlrpc_codec.dumps_response(result, self.allow_none)
         except xmlrpc.client.Fault as fault:
-            response = xmlrpc.client.dumps(fault, allow_none=self.allow_none)
+            return xmlrpc_codec.dumps_fault(fault, self.allow_none)
         except BaseException as exc:  # any error of a call is the caller's fault answer
-            response = xmlrpc.client.dumps(xmlrpc.client.Fault(1, _fault_text(exc)),
-                                           allow_none=self.allow_none)
-        return response.encode("utf-8", "xmlcharrefreplace")
+            return xmlrpc_codec.dumps_fault(xmlrpc.client.Fault(1, _fault_text(exc)),
+                                            self.allow_none)
 
     def dispatch(self, method: str, params: tuple[Any, ...]) -> Any:
         func = self.funcs.get(method)
