@@ -2,18 +2,26 @@
 
 Plain Python, no pytest. Both masters run as separate processes started the same way and
 pinned to the same CPU (``orchestra core -p PORT --no-rosout`` and ``rosmaster --core -p
-PORT``), and are filled and called by the same client code in this process
-(``xmlrpc.client``, like rospy): per-call rates of getParam/setParam, getParam('/') with
-1,000 params, getSystemState with 1,000 registrations, and the time of 1,000 sequential
-registerPublisher calls and of one multicall of 1,000 setParam. Every measurement is taken
-``--rounds`` times, interleaved between the two masters; the tables show medians. Skipped
-with a message when /usr/bin/rosmaster is missing (orchestra's figures still print).
+PORT``), and are filled and called by the same client code in this process: per-call rates
+of getParam/setParam, getParam('/') with 1,000 params, getSystemState with 1,000
+registrations, and the time of 1,000 sequential registerPublisher calls and of one multicall
+of 1,000 setParam.
+
+Two clients, each used identically for both masters, each row labelled with its client:
+``xmlrpc.client`` (what rospy uses; it costs ~70 us a call itself, which hides differences
+between servers) and ``raw``: requests written by ``xmlrpc.client.dumps`` before the clock
+starts, sent on one kept-alive HTTP/1.1 connection, the reply read up to its
+Content-Length and only its status code checked: about as little as a client can do, so
+these rows show what the servers themselves cost. Every measurement is taken ``--rounds``
+times, interleaved between the two masters; the tables show medians. Skipped with a message
+when /usr/bin/rosmaster is missing (orchestra's figures still print).
 
 Usage: ``python bench/bench_master.py [--quick] [--seconds 1.0] [--rounds 5] [--cpu N]``
 """
 from __future__ import annotations
 
 import argparse
+import itertools
 import os
 import shutil
 import socket
@@ -23,6 +31,7 @@ import sys
 import time
 import xmlrpc.client
 from collections.abc import Callable
+from urllib.parse import urlsplit
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import ros1  # noqa: E402
@@ -44,6 +53,61 @@ def rate(fn, seconds: float) -> float:
         now = time.perf_counter()
         if now >= deadline:
             return calls / (now - start)
+
+
+class RawClient:
+    """An HTTP/1.1 XML-RPC client that sends request bodies it is given, pre-built, on one
+    kept-alive connection (re-opened when the server closes it) and checks only that the
+    answer is HTTP 200 carrying ROS status code 1: the same few syscalls and byte scans for
+    every server, so the server's own cost is what differs."""
+
+    def __init__(self, uri: str) -> None:
+        where = urlsplit(uri)
+        self.address = (where.hostname or "127.0.0.1", where.port or 80)
+        self.head = (f"POST / HTTP/1.1\r\nHost: {self.address[0]}:{self.address[1]}\r\n"
+                     "User-Agent: bench\r\nContent-Type: text/xml\r\nContent-Length: ")
+        self.sock: socket.socket | None = None
+        self.buffer = b""
+
+    def call(self, body: bytes) -> bytes:
+        if self.sock is None:
+            self.sock = socket.create_connection(self.address)
+            self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            self.buffer = b""
+        self.sock.sendall(f"{self.head}{len(body)}\r\n\r\n".encode() + body)
+        buffer = self.buffer
+        while (end := buffer.find(b"\r\n\r\n")) < 0:
+            buffer += self._recv()
+        head = buffer[:end].lower()
+        start = head.index(b"content-length:") + 15
+        stop = head.find(b"\r\n", start)
+        length = int(head[start:stop if stop >= 0 else None])
+        end += 4
+        while len(buffer) < end + length:
+            buffer += self._recv()
+        reply, self.buffer = buffer[end:end + length], buffer[end + length:]
+        if not head.startswith(b"http/1.1 200") or b"connection: close" in head:
+            self.close()
+        if not head.startswith((b"http/1.0 200", b"http/1.1 200")) or (
+                b"<value><int>1</int></value>" not in reply[:200]):
+            raise RuntimeError(f"unexpected answer {head!r} {reply[:300]!r}")
+        return reply
+
+    def _recv(self) -> bytes:
+        assert self.sock is not None
+        chunk = self.sock.recv(1 << 16)
+        if not chunk:
+            raise ConnectionError("the server closed the connection")
+        return chunk
+
+    def close(self) -> None:
+        if self.sock is not None:
+            self.sock.close()
+            self.sock = None
+
+
+def request(method: str, *params: object) -> bytes:
+    return xmlrpc.client.dumps(params, method).encode()
 
 
 def free_port() -> int:
@@ -110,21 +174,38 @@ def populate(param_uri: str, graph_uri: str, n: int) -> None:
     assert sum(len(ids) for section in state for _, ids in section) == n
 
 
-def register_publishers(uri: str, n: int, round_no: int) -> float:
+def _publisher(i: int, prefix: str) -> tuple[str, str, str, str]:
+    return (f"/pub{i}", f"{prefix}/topic{i}", "std_msgs/String",
+            f"http://127.0.0.1:{40000 + i % 20000}/")
+
+
+def register_publishers(uri: str, n: int, prefix: str) -> float:
     """Seconds for ``n`` sequential registerPublisher calls (new topics every round)."""
     g = xmlrpc.client.ServerProxy(uri)
     start = time.perf_counter()
     for i in range(n):
-        g.registerPublisher(f"/pub{i}", f"/r{round_no}/topic{i}", "std_msgs/String",
-                            f"http://127.0.0.1:{40000 + i % 20000}/")
+        g.registerPublisher(*_publisher(i, prefix))
     return time.perf_counter() - start
 
 
-def multicall_set(uri: str, n: int, round_no: int) -> float:
+def register_publishers_raw(uri: str, n: int, prefix: str) -> float:
+    """``register_publishers`` through the raw client (requests built before the clock)."""
+    bodies = [request("registerPublisher", *_publisher(i, prefix)) for i in range(n)]
+    client = RawClient(uri)
+    client.call(request("getPid", "/bench"))  # connected before the clock starts
+    start = time.perf_counter()
+    for body in bodies:
+        client.call(body)
+    took = time.perf_counter() - start
+    client.close()
+    return took
+
+
+def multicall_set(uri: str, n: int, prefix: str) -> float:
     """Seconds for one system.multicall of ``n`` setParam calls."""
     multi = xmlrpc.client.MultiCall(xmlrpc.client.ServerProxy(uri))
     for i in range(n):
-        multi.setParam("/bench", f"/multi/r{round_no}/p{i}", i)
+        multi.setParam("/bench", f"{prefix}/p{i}", i)
     start = time.perf_counter()
     results = list(multi())
     took = time.perf_counter() - start
@@ -132,16 +213,45 @@ def multicall_set(uri: str, n: int, round_no: int) -> float:
     return took
 
 
+def multicall_set_raw(uri: str, n: int, prefix: str) -> float:
+    """``multicall_set`` through the raw client (the request built before the clock)."""
+    body = request("system.multicall", [
+        {"methodName": "setParam", "params": ["/bench", f"{prefix}/p{i}", i]}
+        for i in range(n)])
+    client = RawClient(uri)
+    client.call(request("getPid", "/bench"))
+    start = time.perf_counter()
+    reply = client.call(body)
+    took = time.perf_counter() - start
+    client.close()
+    assert reply.count(b"<int>1</int>") == n
+    return took
+
+
 def rate_cases(param_uri: str, graph_uri: str, n: int) -> list[tuple[str, Callable[[], object]]]:
-    """The calls measured on any master, through one client (xmlrpc.client, like rospy)."""
+    """The calls measured on any master, through each client."""
     m = xmlrpc.client.ServerProxy(param_uri)
     g = xmlrpc.client.ServerProxy(graph_uri)
     counter = iter(range(10 ** 9))
+    raw_m, raw_g = RawClient(param_uri), RawClient(graph_uri)
+    get = request("getParam", "/bench", "/robot/gain")
+    sets = itertools.cycle([request("setParam", "/bench", "/robot/gain", i)
+                            for i in range(1000)])  # a new value every call, as above
+    get_all = request("getParam", "/b", "/")
+    state = request("getSystemState", "/b")
     return [
-        ("getParam (leaf), calls/s", lambda: m.getParam("/bench", "/robot/gain")),
-        ("setParam (leaf), calls/s", lambda: m.setParam("/bench", "/robot/gain", next(counter))),
-        ("getParam('/') with 1,000 params, calls/s", lambda: m.getParam("/b", "/")),
-        (f"getSystemState with {n:,} registrations, calls/s", lambda: g.getSystemState("/b")),
+        ("[xmlrpc.client] getParam (leaf), calls/s", lambda: m.getParam("/bench", "/robot/gain")),
+        ("[xmlrpc.client] setParam (leaf), calls/s",
+         lambda: m.setParam("/bench", "/robot/gain", next(counter))),
+        ("[xmlrpc.client] getParam('/') with 1,000 params, calls/s",
+         lambda: m.getParam("/b", "/")),
+        (f"[xmlrpc.client] getSystemState with {n:,} registrations, calls/s",
+         lambda: g.getSystemState("/b")),
+        ("[raw] getParam (leaf), calls/s", lambda: raw_m.call(get)),
+        ("[raw] setParam (leaf), calls/s", lambda: raw_m.call(next(sets))),
+        ("[raw] getParam('/') with 1,000 params, calls/s", lambda: raw_m.call(get_all)),
+        (f"[raw] getSystemState with {n:,} registrations, calls/s",
+         lambda: raw_g.call(state)),
     ]
 
 
@@ -172,16 +282,21 @@ def main() -> None:
         for params, graph in sides.values():
             populate(params.uri, graph.uri, n)
         names = [name for name, _ in rate_cases("http://x/", "http://x/", n)]
-        names += ["1,000 registerPublisher, sequential, ms", "multicall of 1,000 setParam, ms"]
+        timed = [("[xmlrpc.client] 1,000 registerPublisher, sequential, ms", register_publishers),
+                 ("[xmlrpc.client] multicall of 1,000 setParam, ms", multicall_set),
+                 ("[raw] 1,000 registerPublisher, sequential, ms", register_publishers_raw),
+                 ("[raw] multicall of 1,000 setParam, ms", multicall_set_raw)]
+        names += [name for name, _ in timed]
         results: dict[str, list[list[float]]] = {side: [[] for _ in names] for side in sides}
         for round_no in range(args.rounds):
             for side, (params, graph) in sides.items():   # interleaved
                 cases = rate_cases(params.uri, graph.uri, n)
                 for i, (_, fn) in enumerate(cases):
                     results[side][i].append(rate(fn, seconds))
-                results[side][len(cases)].append(
-                    register_publishers(graph.uri, 1000, round_no) * 1e3)
-                results[side][len(cases) + 1].append(multicall_set(params.uri, 1000, round_no) * 1e3)
+                for j, (_, run) in enumerate(timed):
+                    uri = graph.uri if "register" in run.__name__ else params.uri
+                    results[side][len(cases) + j].append(
+                        run(uri, 1000, f"/r{round_no}/{j}") * 1e3)
     finally:
         for masters in sides.values():
             for master in masters:
