@@ -7,7 +7,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from orchestra.errors import OrchestraError
-from orchestra.params.dump_launch import LaunchParamsDumper, _c_emits_the_same, dump_launch_params
+from orchestra.params.dump_launch import dump_launch_params, plain_document
+from orchestra.params.dump_launch_yaml import LaunchParamsDumper, _c_emits_the_same
 from orchestra.params.yaml import flatten, load_rosparam_yaml
 
 
@@ -91,6 +92,37 @@ def test_dump_params_is_pyyamls_safe_dump_byte_for_byte(params):
     """--dump-params takes libyaml's emitter only where it writes PyYAML's bytes."""
     assert dump_launch_params(params) == yaml.dump(params, Dumper=LaunchParamsDumper,
                                                    default_flow_style=False)
+
+
+_NAMEISH = st.text(alphabet=st.sampled_from(list("abyYnNoOfFtTlLuUeE_/.-019: ~<=#")),
+                   max_size=12)
+_SCALARS = (st.none() | st.booleans() | st.integers() | st.floats() | _NAMEISH
+            | st.text(alphabet="/a ", min_size=60, max_size=100)
+            | st.text(alphabet="/a", min_size=70, max_size=300))
+
+
+@settings(max_examples=500, deadline=None)
+@given(st.dictionaries(_NAMEISH | st.text(alphabet="/a", min_size=118, max_size=126),
+                       _SCALARS | st.lists(_SCALARS, max_size=3), max_size=6))
+def test_dump_params_of_plain_names_and_numbers_is_pyyamls_too(params):
+    """The documents written without yaml (names, paths, words, numbers and lists of them)
+    are PyYAML's bytes, and so are the ones it hands to yaml."""
+    expected = yaml.dump(params, Dumper=LaunchParamsDumper, default_flow_style=False)
+    assert dump_launch_params(params) == expected
+    assert plain_document(params) in (None, expected)
+
+
+def test_a_document_of_names_and_numbers_is_written_without_yaml():
+    params = {"/a/rate": 10, "/a/frame": "base_link", "/a/gain": 0.5, "/b/path": "/x/y.yaml",
+              "/b/on": True, "/b/big": 1e17, "/c": None, "/d": "", "/e": ["Motor State", 2],
+              "/f": [], "/g": "Input Ports"}
+    assert plain_document(params) == yaml.dump(params, Dumper=LaunchParamsDumper,
+                                               default_flow_style=False)
+    assert plain_document({}) == "{}\n"
+    for other in ({"/a": "yes"}, {"/a": "10"}, {"/a": "a: b"}, {"/a": [[1]]}, {"/a": {}},
+                  {"/" + "k" * 122: 1}, {"/a": b"x"}, {"/a": "~"}, {"/a": "a " * 40 + "b"},
+                  {"/a b": 1}, {"/a": " a"}):
+        assert plain_document(other) is None, other
 
 
 def test_dump_params_takes_the_c_emitter_for_plain_text_and_numbers():

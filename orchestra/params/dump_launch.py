@@ -1,66 +1,99 @@
 """The YAML document ``roslaunch --dump-params`` prints: every parameter of a launch.
 
-Scripts diff it against roslaunch's, so it is PyYAML's ``safe_dump`` byte for byte; big
-trees are written by libyaml's emitter wherever that gives the same bytes. Its own module
-(not rosparam's ``dump``) because ``orchestra launch --dump-params`` is a start-up-time path:
-it imports yaml and nothing of the XML-RPC client.
+Scripts diff it against roslaunch's, so it is PyYAML's ``safe_dump`` byte for byte. Its own
+module (not rosparam's ``dump``) because ``orchestra launch --dump-params`` is a start-up-time
+path: it imports nothing of the XML-RPC client, and a document whose names and values are all
+plain (names, paths, words, numbers, booleans, lists of them: most launches) is written here
+without importing yaml at all (a sixth of a one-node ``--dump-params``). Every other document
+is PyYAML's (``dump_launch_yaml.py``); tests/test_params_yaml.py checks both against
+``yaml.dump``.
 """
 from __future__ import annotations
 
+import math
+import re
 from typing import Any
 
-import yaml
+#: text PyYAML writes as it is (a plain scalar): names, paths and words of these characters,
+#: unless YAML 1.1 reads it as something else than text (the words below; the leading
+#: character rules out numbers, dates, ``~``, ``.inf``, ``<<`` and indicators)
+_PLAIN_TEXT = re.compile(r"[A-Za-z_/][A-Za-z0-9_./-]*(?: [A-Za-z0-9_./-]+)*\Z")
+_NOT_TEXT = frozenset(("yes", "Yes", "YES", "no", "No", "NO", "true", "True", "TRUE", "false",
+                       "False", "FALSE", "on", "On", "ON", "off", "Off", "OFF", "null", "Null",
+                       "NULL"))
+#: PyYAML folds plain text at a space past this column
+_WIDTH = 80
+#: PyYAML writes a longer key as ``? key`` (it counts the key's 5-character ``!!str`` tag into
+#: its 128-character limit of a simple key)
+_SIMPLE_KEY_MAX = 122
 
 
-class LaunchParamsDumper(yaml.SafeDumper):
-    """PyYAML's safe dumper as ``roslaunch --dump-params`` uses it; bytes (binfile) values
-    (also subclasses) as ``!!binary``."""
+def _plain_scalar(value: Any, before: int) -> str | None:
+    """``value`` as PyYAML's safe dumper writes it after ``before`` characters of its line,
+    when that is one plain or empty scalar of the kinds above (text, exact ints, floats,
+    booleans, None); None for anything else."""
+    kind = type(value)
+    if kind is str:
+        if not value:
+            return "''"
+        if (_PLAIN_TEXT.match(value) is None or value in _NOT_TEXT
+                or (" " in value and before + len(value) > _WIDTH)):
+            return None
+        return value
+    if kind is bool:
+        return "true" if value else "false"
+    if kind is int:
+        return str(value)
+    if kind is float:
+        if value != value:
+            return ".nan"
+        if math.isinf(value):
+            return ".inf" if value > 0 else "-.inf"
+        text = repr(value).lower()
+        # 1e+17 is no YAML 1.1 float; PyYAML writes it 1.0e+17
+        return text.replace("e", ".0e", 1) if "." not in text and "e" in text else text
+    if value is None:
+        return "null"
+    return None
 
 
-class CLaunchParamsDumper(yaml.CSafeDumper):
-    """The same with libyaml's C emitter: ~4x faster on big trees, and the same bytes
-    wherever ``_c_emits_the_same`` says so."""
+def _entry(key: Any, value: Any) -> str | None:
+    """The lines of ``key: value`` in PyYAML's block document, when both are plain (a list
+    of plain scalars is a block sequence under the key); None otherwise."""
+    if (type(key) is not str or len(key) > _SIMPLE_KEY_MAX or " " in key
+            or _plain_scalar(key, 0) != key):
+        return None
+    if type(value) is list:
+        if not value:
+            return f"{key}: []\n"
+        items = [_plain_scalar(item, 2) for item in value]
+        if None in items:
+            return None
+        return f"{key}:\n" + "".join(f"- {item}\n" for item in items)
+    text = _plain_scalar(value, len(key) + 2)
+    return None if text is None else f"{key}: {text}\n"
 
 
-for _dumper in (LaunchParamsDumper, CLaunchParamsDumper):
-    _dumper.add_multi_representer(bytes, yaml.SafeDumper.represent_binary)
-
-# libyaml folds long double-quoted scalars at other columns than PyYAML, and PyYAML counts
-# the key's "!!str" tag into its 128-character limit of a simple key where libyaml does not
-# (keys of 123-128 characters: ``? key`` in one, ``key:`` in the other), and writes an empty
-# key as ``? ''``. Plain, single-quoted and literal scalars come out the same; double quotes
-# are only chosen for text with a character outside printable ASCII (line breaks, tabs,
-# non-ASCII).
-_KEY_LENGTHS_THAT_DIFFER = range(123, 129)
-
-
-def _c_emits_the_same(value: Any) -> bool:
-    """Whether libyaml's emitter writes ``value`` byte for byte as PyYAML's does."""
-    if isinstance(value, str):
-        return value.isascii() and value.isprintable()
-    if isinstance(value, dict):
-        return all(isinstance(k, str) and k and len(k) not in _KEY_LENGTHS_THAT_DIFFER
-                   and k.isascii() and k.isprintable() and _c_emits_the_same(v)
-                   for k, v in value.items())
-    if isinstance(value, list):
-        return all(_c_emits_the_same(v) for v in value)
-    return value is None or isinstance(value, (bool, int, float, bytes))
+def plain_document(params: dict[str, Any]) -> str | None:
+    """PyYAML's block document of ``params`` when every entry is plain (see ``_entry``), in
+    key order; None otherwise."""
+    if not params:
+        return "{}\n"
+    lines = []
+    for key in sorted(params):
+        entry = _entry(key, params[key])
+        if entry is None:
+            return None
+        lines.append(entry)
+    return "".join(lines)
 
 
 def dump_launch_params(params: dict[str, Any]) -> str:
     """The YAML document ``roslaunch --dump-params`` prints for ``params`` (PyYAML's
-    safe_dump: block style, sorted keys, ASCII escapes).
+    safe_dump: block style, sorted keys, ASCII escapes)."""
+    text = plain_document(params)
+    if text is None:
+        from orchestra.params.dump_launch_yaml import yaml_document
 
-    A block mapping at the top is its entries one after the other, so the sorted entries are
-    written in runs, each by the emitter that writes it as PyYAML does (a deep tree's long
-    names would otherwise send all of it to the slow one)."""
-    runs: list[tuple[bool, dict[str, Any]]] = []
-    for key in sorted(params):
-        fast = _c_emits_the_same({key: params[key]})
-        if not runs or runs[-1][0] != fast:
-            runs.append((fast, {}))
-        runs[-1][1][key] = params[key]
-    if not runs:
-        return yaml.dump(params, Dumper=LaunchParamsDumper, default_flow_style=False)
-    return "".join(yaml.dump(run, Dumper=CLaunchParamsDumper if fast else LaunchParamsDumper,
-                             default_flow_style=False) for fast, run in runs)
+        text = yaml_document(params)
+    return text
