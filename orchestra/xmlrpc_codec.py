@@ -278,45 +278,69 @@ def _escape(text: str) -> str:
     return text
 
 
+def _scalar_xml(value: Any) -> str | None:
+    """A str, an int in range, a bool or a float as the stdlib writes it; None otherwise."""
+    kind = type(value)
+    if kind is str:
+        if "&" in value or "<" in value or ">" in value:
+            value = _escape(value)
+        return f"<value><string>{value}</string></value>\n"
+    if kind is int:
+        if MININT <= value <= MAXINT:
+            return f"<value><int>{value}</int></value>\n"
+        return None
+    if kind is float:
+        return f"<value><double>{value!r}</double></value>\n"
+    if kind is bool:
+        return "<value><boolean>1</boolean></value>\n" if value else \
+            "<value><boolean>0</boolean></value>\n"
+    return None
+
+
 def _write(value: Any, out: list[str], allow_none: bool, depth: int) -> None:
     """Append ``value`` as the stdlib Marshaller writes it; anything but the built-in types
     (subclasses, wrappers, instances), a None not allowed and very deep nesting are
-    ``_Unusual``: the stdlib writes (or refuses) those."""
+    ``_Unusual``: the stdlib writes (or refuses) those. A container's scalars are written in
+    its own loop (most values of a parameter tree are leaves)."""
+    append = out.append
     kind = type(value)
-    if kind is str:
-        out.append(f"<value><string>{_escape(value)}</string></value>\n")
-    elif kind is int:
-        if value > MAXINT or value < MININT:
-            raise OverflowError("int exceeds XML-RPC limits")
-        out.append(f"<value><int>{value}</int></value>\n")
-    elif kind is bool:
-        out.append("<value><boolean>1</boolean></value>\n" if value
-                   else "<value><boolean>0</boolean></value>\n")
-    elif kind is float:
-        out.append(f"<value><double>{value!r}</double></value>\n")
-    elif kind is list or kind is tuple:
+    if kind is dict:
         if depth > 64:
             raise _Unusual  # the stdlib tells recursion from depth
-        out.append("<value><array><data>\n")
-        for item in value:
-            _write(item, out, allow_none, depth + 1)
-        out.append("</data></array></value>\n")
-    elif kind is dict:
-        if depth > 64:
-            raise _Unusual
-        out.append("<value><struct>\n")
+        append("<value><struct>\n")
         for key, item in value.items():
             if type(key) is not str:
                 raise _Unusual
-            out.append(f"<member>\n<name>{_escape(key)}</name>\n")
-            _write(item, out, allow_none, depth + 1)
-            out.append("</member>\n")
-        out.append("</struct></value>\n")
+            if "&" in key or "<" in key or ">" in key:
+                key = _escape(key)
+            leaf = _scalar_xml(item)
+            if leaf is not None:
+                append(f"<member>\n<name>{key}</name>\n{leaf}</member>\n")
+            else:
+                append(f"<member>\n<name>{key}</name>\n")
+                _write(item, out, allow_none, depth + 1)
+                append("</member>\n")
+        append("</struct></value>\n")
+    elif kind is list or kind is tuple:
+        if depth > 64:
+            raise _Unusual
+        append("<value><array><data>\n")
+        for item in value:
+            leaf = _scalar_xml(item)
+            if leaf is not None:
+                append(leaf)
+            else:
+                _write(item, out, allow_none, depth + 1)
+        append("</data></array></value>\n")
+    elif kind is int and not MININT <= value <= MAXINT:
+        raise OverflowError("int exceeds XML-RPC limits")
+    elif kind is str or kind is int or kind is float or kind is bool:
+        append(_scalar_xml(value) or "")
     elif value is None and allow_none:
-        out.append("<value><nil/></value>")
+        append("<value><nil/></value>")
     elif kind is bytes or kind is bytearray:
-        out.append(f"<value><base64>\n{base64.encodebytes(value).decode('ascii')}"
-                   "</base64></value>\n")
+        append(f"<value><base64>\n{base64.encodebytes(value).decode('ascii')}"
+               "</base64></value>\n")
     else:
         raise _Unusual
 

@@ -96,9 +96,13 @@ def check_value(name: str, value: Any, location: Location | None = None) -> None
 
 def _copy_dicts(value: Any) -> Any:
     """Copy the dict skeleton of a value: the tree mutates dicts in place, never lists."""
-    if isinstance(value, dict):
-        return {k: _copy_dicts(v) for k, v in value.items()}
-    return value
+    if not isinstance(value, dict):
+        return value
+    copy = value.copy()
+    for k, v in copy.items():
+        if isinstance(v, dict):
+            copy[k] = _copy_dicts(v)
+    return copy
 
 
 # --- subscriptions ---------------------------------------------------------------------------
