@@ -11,6 +11,7 @@ from __future__ import annotations
 import atexit
 import logging
 import os
+import selectors
 import socket
 import socketserver
 import threading
@@ -391,11 +392,57 @@ class ThreadedServer(socketserver.ThreadingMixIn, _XMLRPCServer):
                  handler: type[AnyPathHandler] = AnyPathHandler,
                  allow_none: bool = False):
         self.address_family = socket.AF_INET6 if ":" in addr[0] else socket.AF_INET
+        self._wake_r, self._wake_w = os.pipe()   # first: a failed bind calls server_close
+        self._stop_asked = threading.Event()
+        self._serving_done = threading.Event()
+        self._serving_done.set()
         super().__init__(addr, handler=handler, allow_none=allow_none)
 
     @property
     def port(self) -> int:
         return int(self.server_address[1])
+
+    def serve_forever(self, poll_interval: float = 0.5) -> None:
+        """Serve until ``shutdown()``, which wakes this loop at once.
+
+        socketserver's loop only notices a shutdown at its next poll, so every stop of a
+        node (its slave API) or of a master waited up to ``poll_interval`` (0.2 s for a
+        node): most of the time a Python node took to exit after SIGINT.
+        """
+        self._serving_done.clear()
+        try:
+            with selectors.DefaultSelector() as selector:
+                selector.register(self, selectors.EVENT_READ)
+                selector.register(self._wake_r, selectors.EVENT_READ)
+                while not self._stop_asked.is_set():
+                    ready = [key.fileobj for key, _ in selector.select(poll_interval)]
+                    if self._wake_r in ready:
+                        os.read(self._wake_r, 64)
+                    if self._stop_asked.is_set():
+                        break
+                    if self in ready:
+                        self._handle_request_noblock()  # type: ignore[attr-defined]
+                    self.service_actions()
+        finally:
+            self._stop_asked.clear()
+            self._serving_done.set()
+
+    def shutdown(self) -> None:
+        """Stop ``serve_forever`` (now, not at its next poll) and wait until it returned."""
+        self._stop_asked.set()
+        if self._wake_w >= 0:    # (closed: nothing is serving)
+            try:
+                os.write(self._wake_w, b"x")
+            except OSError:
+                pass
+        self._serving_done.wait()
+
+    def server_close(self) -> None:
+        super().server_close()
+        for fd in (self._wake_r, self._wake_w):
+            if fd >= 0:
+                os.close(fd)
+        self._wake_r = self._wake_w = -1    # never write to a number reused meanwhile
 
 
 class PolledServer(_XMLRPCServer):

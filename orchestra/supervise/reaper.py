@@ -108,13 +108,42 @@ def signal_group(pgid: int, sig: int, extra: Iterable[int] = ()) -> None:
             pass
 
 
+def _children_table() -> dict[int, list[int]]:
+    """Parent pid -> its children's pids, for every live process.
+
+    Read from ``/proc/PID/stat`` directly where there is one: the stop of a launch waits
+    for this before signalling its nodes, and psutil's per-process objects made it
+    ~10x slower (tens of ms on a loaded machine with a few hundred processes).
+    """
+    children: dict[int, list[int]] = {}
+    try:
+        entries = os.listdir("/proc")
+    except OSError:
+        entries = None
+    if entries is None or not os.path.exists("/proc/self/stat"):
+        for proc in psutil.process_iter(["ppid"]):
+            ppid = proc.info.get("ppid")
+            if ppid is not None:
+                children.setdefault(ppid, []).append(proc.pid)
+        return children
+    for entry in entries:
+        if not entry.isdigit():
+            continue
+        try:
+            with open(f"/proc/{entry}/stat", "rb") as fh:
+                stat = fh.read()
+        except OSError:
+            continue          # gone meanwhile
+        # "pid (comm) state ppid ...": comm may hold spaces and parentheses
+        fields = stat[stat.rfind(b")") + 2:].split(b" ", 2)
+        if len(fields) >= 2:
+            children.setdefault(int(fields[1]), []).append(int(entry))
+    return children
+
+
 def descendants(roots: Iterable[int]) -> dict[int, list[int]]:
     """For each root pid, all its live descendants (one pass over the process table)."""
-    children: dict[int, list[int]] = {}
-    for proc in psutil.process_iter(["ppid"]):
-        ppid = proc.info.get("ppid")
-        if ppid is not None:
-            children.setdefault(ppid, []).append(proc.pid)
+    children = _children_table()
     result: dict[int, list[int]] = {}
     for root in roots:
         found: list[int] = []
