@@ -11,12 +11,15 @@
 4. supervisor CPU with N idle nodes over a window (orchestra process, embedded master
    included), in % of one core. Target: < 1 %.
 5. against the real ROS 1 roslaunch (Debian's 1.15, /usr/bin/roslaunch), the same launch file
-   of N trivial sleeping ``#!/usr/bin/python3`` nodes, each launcher starting its own master
-   on a free port, both probed the same way (the launcher's descendant processes):
-   start until all N node processes run; SIGINT to the launcher until it and every node are
-   gone; a launch whose nodes ignore SIGINT (default timeouts, then ``--sigint-timeout``);
-   and the processes left running after the launcher is SIGKILLed (orphans, then killed).
-   Skipped with a message when roslaunch is missing.
+   of N trivial sleeping nodes, each launcher starting its own master on a free port, both
+   probed the same way (the launcher's descendant processes running the node's program):
+   start until all N node processes run, and SIGINT to the launcher until it and every node
+   are gone (interleaved, medians), once with ``#!/usr/bin/python3`` nodes (100 interpreter
+   start-ups on the same cores: a floor both sides share) and once with native nodes (a tiny
+   C program built with ``cc``, as roscpp nodes are native: what the launchers themselves
+   cost; skipped without a compiler); a launch whose nodes ignore SIGINT (default timeouts,
+   then ``--sigint-timeout``); and the processes left running after the launcher is
+   SIGKILLed (orphans, then killed). Skipped with a message when roslaunch is missing.
 """
 from __future__ import annotations
 
@@ -24,6 +27,7 @@ import argparse
 import io
 import json
 import os
+import shutil
 import signal
 import socket
 import statistics
@@ -203,6 +207,44 @@ while True:
 """
 
 
+NATIVE_NODE = r"""
+/* a trivial native node (as roscpp nodes are): sleeps until SIGINT or SIGTERM */
+#include <signal.h>
+#include <unistd.h>
+static void on_signal(int sig) { (void)sig; _exit(0); }
+int main(void) {
+    signal(SIGINT, on_signal);
+    signal(SIGTERM, on_signal);
+    for (;;) pause();
+}
+"""
+
+
+def build_native_node(root: str) -> bool:
+    """Compile NATIVE_NODE as ``rbench/scripts/native`` with the C compiler; False if none."""
+    pkg = os.path.join(root, "ws", "rbench", "scripts")
+    os.makedirs(pkg, exist_ok=True)
+    source = os.path.join(root, "native.c")
+    with open(source, "w") as fh:
+        fh.write(NATIVE_NODE)
+    compiler = next((c for c in ("cc", "gcc", "clang") if shutil.which(c)), None)
+    if compiler is None:
+        return False
+    done = subprocess.run([compiler, "-O2", "-o", os.path.join(pkg, "native"), source],
+                          capture_output=True)
+    return done.returncode == 0
+
+
+def make_native_launch(root: str, n: int) -> str:
+    launch = os.path.join(root, f"native_{n}.launch")
+    with open(launch, "w") as fh:
+        fh.write("<launch>\n")
+        for i in range(n):
+            fh.write(f'  <node pkg="rbench" type="native" name="c{i:03d}"/>\n')
+        fh.write("</launch>\n")
+    return launch
+
+
 def make_py_workspace(root: str, n: int, stubborn: int = 0) -> str:
     """Package ``rbench`` with the python nodes ``sleeper`` and ``stubborn``; a launch of
     ``n`` sleepers plus ``stubborn`` SIGINT-ignoring nodes. Returns the launch file."""
@@ -330,23 +372,44 @@ class Launcher:
             pass
 
 
+#: issue 15's targets, by row (orchestra time / roslaunch time)
+TARGETS = {"start": "<= 0.25x", "SIGINT to launcher": "<= 0.15x"}
+
+
 def real_roslaunch_comparison(n: int, quick: bool) -> list:
     """Rows (what, orchestra, roslaunch, note) for section 5."""
     rows: list = []
     with tempfile.TemporaryDirectory() as root:
         launch = make_py_workspace(root, n)
-        # start, then SIGINT stop
-        for kind in ("orchestra", "roslaunch"):
-            run = Launcher(kind, launch, root)
-            try:
-                rows.append([f"start {n} python nodes until all run", kind,
-                             run.wait_running(n)])
-                time.sleep(1.0)  # let the launcher settle (registrations, rosout)
-                took, left = run.stop(40)
-                rows.append([f"SIGINT to launcher -> launcher and {n} nodes gone", kind, took,
-                             f"{left} left" if left else ""])
-            finally:
-                run.kill()
+        launches = [("python", launch)]
+        if build_native_node(root):
+            launches.append(("native", make_native_launch(root, n)))
+        else:
+            rows.append([f"start {n} native nodes", "orchestra", None,
+                         "skipped: no C compiler (cc) to build the native node"])
+        # start, then SIGINT stop; interleaved, median of `repeat` runs each
+        repeat = 3 if quick else 5
+        for what, file in launches:
+            times: dict[str, dict[str, list[float]]] = {}
+            for _ in range(repeat):
+                for kind in ("orchestra", "roslaunch"):
+                    run = Launcher(kind, file, root)
+                    try:
+                        started = run.wait_running(n)
+                        time.sleep(1.0)  # let the launcher settle (registrations, rosout)
+                        took, left = run.stop(40)
+                    finally:
+                        run.kill()
+                    mine = times.setdefault(kind, {"start": [], "stop": []})
+                    mine["start"].append(started)
+                    mine["stop"].append(took)
+                    if left:
+                        rows.append([f"SIGINT with {what} nodes", kind, None, f"{left} left"])
+            for kind, figures in times.items():
+                rows.append([f"start {n} {what} nodes until all run (median of {repeat})",
+                             kind, statistics.median(figures["start"])])
+                rows.append([f"SIGINT to launcher -> launcher and {n} {what} nodes gone "
+                             f"(median of {repeat})", kind, statistics.median(figures["stop"])])
         # SIGINT-ignoring nodes: default escalation, then --sigint-timeout
         stubborn = 3
         launch_x = make_py_workspace(root, 10, stubborn)
@@ -436,14 +499,20 @@ def main() -> None:
     print(f"{'supervisor CPU, ' + str(n) + ' idle nodes (% of one core)':<52} "
           f"{figures['idle_cpu']:>9.2f}% {'':>10} {'':>7}  < 1 %")
     if real_rows:
-        print(f"\n{'against real roslaunch (same launch file)':<72} {'orchestra':>10} "
-              f"{'roslaunch':>10} {'ratio':>7}")
+        print(f"\n{'against real roslaunch (same launch file)':<80} {'orchestra':>10} "
+              f"{'roslaunch':>10} {'ratio':>7}  target")
         for what, ours, theirs, note in real_rows:
-            if isinstance(ours, int):
-                print(f"{what:<72} {ours:>10} {theirs:>10} {'':>7}  {note}")
+            if ours is None or theirs is None:
+                print(f"{what:<80} {note}")
+            elif isinstance(ours, int):
+                print(f"{what:<80} {ours:>10} {theirs:>10} {'':>7}  {note}")
             else:
-                print(f"{what:<72} {ours:>9.2f}s {theirs:>9.2f}s {theirs / ours:>6.1f}x  {note}")
-        print("ratio = roslaunch time / orchestra time (higher: orchestra faster)")
+                target = next((t for key, t in TARGETS.items() if what.startswith(key)), "")
+                print(f"{what:<80} {ours:>9.2f}s {theirs:>9.2f}s {ours / theirs:>6.2f}x  "
+                      f"{target}{'  ' + note if note else ''}")
+        print("ratio = orchestra time / roslaunch time (lower: orchestra faster). Python nodes:\n"
+              "  both launchers pay 100 /usr/bin/python3 start-ups competing for the same cores\n"
+              "  (a floor shared by both sides); native nodes: what the launchers themselves cost.")
     print(ros1.load_average())
 
 
