@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import queue
 import re
 import select
 import signal
@@ -252,14 +253,28 @@ def _record_progress(recorder, last: tuple[float, int]) -> tuple[float, int]:
 
 
 def _stop_on_signals(event: threading.Event):
-    """SIGINT/SIGTERM set ``event`` (the bag is then closed properly); returns the undo."""
+    """SIGINT/SIGTERM set ``event`` (the bag is then closed properly); returns the undo.
+
+    The handler runs on the main thread between two bytecodes of whatever it was doing,
+    e.g. inside ``event.wait`` holding the event's lock: ``event.set()`` there would wait
+    for that lock forever. So the handler only queues the signal (``SimpleQueue.put`` is
+    re-entrant, safe in a signal handler) and a "bag-signals" thread sets the event."""
+    received: queue.SimpleQueue[int | None] = queue.SimpleQueue()
+
+    def forward() -> None:
+        while received.get() is not None:
+            event.set()
+    thread = threading.Thread(target=forward, name="bag-signals", daemon=True)
+    thread.start()
     previous = {}
     for sig in (signal.SIGINT, signal.SIGTERM):
-        previous[sig] = signal.signal(sig, lambda *_: event.set())
+        previous[sig] = signal.signal(sig, lambda signum, _frame: received.put(signum))
 
     def undo() -> None:
         for sig, handler in previous.items():
             signal.signal(sig, handler)
+        received.put(None)
+        thread.join()
     return undo
 
 
