@@ -83,6 +83,7 @@ class Peers:
     def close(self) -> None:
         for proc in self.procs:
             proc.kill()
+            proc.close_pipes()
 
 
 @pytest.fixture
@@ -94,7 +95,8 @@ def peers(master, tmp_path):
 
 def _state(uri: str) -> tuple[dict, dict]:
     import xmlrpc.client
-    _c, _m, (pubs, subs, _s) = xmlrpc.client.ServerProxy(uri).getSystemState("/test")
+    with xmlrpc.client.ServerProxy(uri) as proxy:
+        _c, _m, (pubs, subs, _s) = proxy.getSystemState("/test")
     return dict(pubs), dict(subs)
 
 

@@ -115,6 +115,7 @@ def test_plot_live_topic_to_a_picture(master, tmp_path):
         assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     finally:
         pub.kill()
+        pub.close_pipes()
 
 
 def test_plot_live_waits_for_a_topic_that_does_not_exist_yet(master, tmp_path):
@@ -141,3 +142,4 @@ def test_plot_live_waits_for_a_topic_that_does_not_exist_yet(master, tmp_path):
             plot.communicate()
         if pub is not None:
             pub.kill()
+            pub.close_pipes()
