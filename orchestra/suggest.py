@@ -6,12 +6,13 @@ finds ``/robot1/talker``.
 """
 from __future__ import annotations
 
-import difflib
 from collections.abc import Iterable
 
 
 def close_matches(word: str, choices: Iterable[str], limit: int = 3) -> list[str]:
     """The choices most like ``word`` (best first), an empty list when none is close."""
+    import difflib  # only a miss pays for it: every launch imports this module
+
     options = sorted(set(choices))
     found = difflib.get_close_matches(word, options, n=limit, cutoff=0.6)
     if not found and "/" in word:

@@ -12,10 +12,10 @@ with HOME unset.
 """
 from __future__ import annotations
 
-import hashlib
 import json
 import logging
 import os
+import zlib
 from collections.abc import Mapping
 
 from orchestra import rosdirs
@@ -37,8 +37,11 @@ def default_cache_dir(environ: Mapping[str, str] | None = None) -> str | None:
 
 
 def cache_file(cache_dir: str, root: str) -> str:
-    digest = hashlib.sha1(root.encode("utf-8", "surrogateescape")).hexdigest()[:16]
-    return os.path.join(cache_dir, f"packages-{digest}.json")
+    """The cache file of ``root``. Named by a CRC-32 of the path, not a cryptographic hash:
+    importing hashlib (OpenSSL) cost every ``$(find)`` process ~3 ms, and two roots that
+    share a name only take turns re-crawling, because the file records its root."""
+    digest = zlib.crc32(root.encode("utf-8", "surrogateescape"))
+    return os.path.join(cache_dir, f"packages-{digest:08x}.json")
 
 
 def load(cache_dir: str | None, root: str) -> dict[str, Record]:
