@@ -16,10 +16,11 @@ from orchestra.errors import OrchestraError
 
 
 def main(argv: list[str] | None = None) -> None:
-    """Run the command line ``argv`` (default: ``sys.argv[1:]``) and exit with its code."""
+    """Run the command line ``argv`` and exit with its code; without ``argv``, this process's
+    own command line (the console script, ``python -m orchestra``), which ends with it."""
     args = sys.argv[1:] if argv is None else list(argv)
     try:
-        rv = _run(args)
+        rv = _run(args, whole_process=argv is None)
     except OrchestraError as exc:
         import click
 
@@ -32,23 +33,32 @@ def main(argv: list[str] | None = None) -> None:
     sys.exit(rv if isinstance(rv, int) else 0)
 
 
-def _run(args: list[str]) -> object:
+def _run(args: list[str], *, whole_process: bool) -> object:
     if args[:1] == ["launch"]:
         from orchestra.app.launch_output import parse_output_request, run_output_request
 
         request = parse_output_request(args[1:])
         if request is not None:
-            import atexit
-            import gc
-
             from orchestra.log_setup import configure_logging
 
-            # a print-and-exit process: what it holds lives until it ends, so the
-            # interpreter's exit need not search it for garbage (~10 % of such a run)
-            atexit.register(gc.freeze)
+            if whole_process:
+                _short_lived()
             configure_logging(0)     # what the click group does without -v
             run_output_request(request)
             return None
     from orchestra.commands import run
 
     return run(args)
+
+
+def _short_lived() -> None:
+    """This process prints and exits: no garbage collector. It makes next to no cyclic
+    garbage (a 1,000-node tree peaks at the same RSS without the collector), while the
+    collector's passes over the growing heap are ~5 % of a one-node dump and ~18 % of a
+    1,000-node one; and what it holds at exit is frozen, so the interpreter's exit does not
+    search it for garbage either (~10 % of a one-node dump)."""
+    import atexit
+    import gc
+
+    gc.disable()
+    atexit.register(gc.freeze)
