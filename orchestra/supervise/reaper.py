@@ -23,39 +23,42 @@ reports "Exec format error"), ``check_executable`` vets the target first.
 """
 from __future__ import annotations
 
-import ctypes
 import errno
 import functools
 import logging
 import os
-import secrets
 import shutil
 import signal
 import subprocess
 import warnings
 from collections.abc import Callable, Iterable, Mapping
 
-import psutil
-
 logger = logging.getLogger(__name__)
 
 PR_SET_PDEATHSIG = 1
 MARK_VARIABLE = "ORCHESTRA_RUN_MARK"
 
-_prctl: Callable[..., int] | None
-try:
-    _libc = ctypes.CDLL(None, use_errno=True)
-    _prctl = _libc.prctl
-except (OSError, AttributeError):  # not Linux: the watchdog alone covers it
-    _prctl = None
+# psutil and ctypes are imported where they are used (the stray scan without /proc, the
+# preexec fallback): a launch imports this module before its first node starts
+
+
+@functools.cache
+def _prctl() -> Callable[..., int] | None:
+    import ctypes
+
+    try:
+        return ctypes.CDLL(None, use_errno=True).prctl
+    except (OSError, AttributeError):  # not Linux: the watchdog alone covers it
+        return None
 
 
 def child_setup(parent_pid: int) -> Callable[[], None]:
     """A ``preexec_fn`` that ties the child's life to ``parent_pid`` (runs in the child)."""
+    prctl = _prctl()   # looked up here, in the parent: the child only calls it
 
     def setup() -> None:
-        if _prctl is not None:
-            _prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+        if prctl is not None:
+            prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
         if os.getppid() != parent_pid:   # the parent died before prctl took effect
             os._exit(127)
 
@@ -121,6 +124,8 @@ def _children_table() -> dict[int, list[int]]:
     except OSError:
         entries = None
     if entries is None or not os.path.exists("/proc/self/stat"):
+        import psutil
+
         for proc in psutil.process_iter(["ppid"]):
             ppid = proc.info.get("ppid")
             if ppid is not None:
@@ -158,7 +163,7 @@ def descendants(roots: Iterable[int]) -> dict[int, list[int]]:
 
 def new_mark() -> str:
     """A value for MARK_VARIABLE that no other run on this machine uses."""
-    return f"{os.getpid()}-{secrets.token_hex(8)}"
+    return f"{os.getpid()}-{os.urandom(8).hex()}"   # (secrets' source, without its import)
 
 
 def marked_pids(mark: str, exclude: Iterable[int] = ()) -> list[int]:

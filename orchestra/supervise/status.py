@@ -13,13 +13,14 @@ import socket
 import stat
 import xmlrpc.client
 from collections.abc import Callable
-from typing import Any
-
-import psutil
+from typing import TYPE_CHECKING, Any
 
 from orchestra.rpc import call, unpack_reply
 from orchestra.supervise.loop import EventLoop, Timer
 from orchestra.supervise.process import ManagedProcess, State
+
+if TYPE_CHECKING:
+    import psutil
 
 SNAPSHOT_VERSION = 1
 MAX_SOCKET_DIR = 90
@@ -47,6 +48,8 @@ class ProcessStats:
     def sample(self, pid: int | None) -> tuple[float | None, int | None]:
         if pid is None:
             return None, None
+        import psutil  # at the first status request, not before a launch's nodes start
+
         handle = self._handles.get(pid)
         try:
             if handle is None:
@@ -274,6 +277,8 @@ def running_launches(directory: str | None = None) -> list[dict[str, Any]]:
         try:
             found.append({**query(path), "socket": path})
         except (ConnectionRefusedError, FileNotFoundError):
+            import psutil
+
             pid = name[:-5].split("-")[0]     # <pid>.sock, or <pid>-<n>.sock (API runs)
             if pid.isdigit() and not psutil.pid_exists(int(pid)):
                 try:

@@ -23,8 +23,6 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
-import psutil
-
 from orchestra.supervise import stop_signals
 from orchestra.supervise.limits import (
     cgroup_unavailable,
@@ -76,7 +74,6 @@ class _Child:
 
     popen: subprocess.Popen
     pidfd: int | None      # None: a waiter thread reports the exit instead
-    ps: psutil.Process | None = None
     extra: list[int] = field(default_factory=list)   # descendants outside the process group
 
 
@@ -628,8 +625,13 @@ class Supervisor:
         node's group: it gets SIGTERM, then SIGKILL after ``stray_timeout``. roslaunch leaves
         such processes running forever.
         """
+        pids = marked_pids(self.mark)
+        if not pids:
+            return
+        import psutil  # (only now: not among what a launch imports before its nodes start)
+
         strays = []
-        for pid in marked_pids(self.mark):
+        for pid in pids:
             try:
                 strays.append(psutil.Process(pid))
             except psutil.NoSuchProcess:
