@@ -23,6 +23,7 @@ reports "Exec format error"), ``check_executable`` vets the target first.
 """
 from __future__ import annotations
 
+import contextlib
 import errno
 import functools
 import logging
@@ -31,7 +32,7 @@ import shutil
 import signal
 import subprocess
 import warnings
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 
 logger = logging.getLogger(__name__)
 
@@ -223,16 +224,38 @@ class Watchdog:
             signal.pthread_sigmask(signal.SIG_SETMASK, held)
         os.close(read_fd)
         self.pid = pid
+        self._pending: list[str] = []
+        self._deferring = False
         self._fd: int | None = write_fd
         os.set_inheritable(write_fd, False)
 
     def _send(self, text: str) -> None:
-        if self._fd is None:
+        self._pending.append(text)
+        if not self._deferring:
+            self.flush()
+
+    def flush(self) -> None:
+        """Write what ``deferred()`` held back."""
+        text, self._pending = "".join(self._pending), []
+        if self._fd is None or not text:
             return
         try:
             os.write(self._fd, text.encode())
         except OSError as exc:
             logger.warning("watchdog unreachable: %s", exc)
+
+    @contextlib.contextmanager
+    def deferred(self) -> Iterator[None]:
+        """Send the changes made inside in one write at the end: each write wakes the
+        watchdog process, and starting or stopping 100 nodes woke it 100 times. (Until
+        then it does not know the newest groups; the run mark and the parent-death signal
+        still cover those.)"""
+        self._deferring = True
+        try:
+            yield
+        finally:
+            self._deferring = False
+            self.flush()
 
     def watch(self, pgid: int) -> None:
         self._send(f"+{pgid}\n")
@@ -244,6 +267,7 @@ class Watchdog:
         """Clean exit: tell the watchdog there is nothing to kill, and reap it."""
         if self._fd is None:
             return
+        self._deferring = False
         self._send("bye\n")
         os.close(self._fd)
         self._fd = None

@@ -12,6 +12,7 @@ exit) or failed to start, or when any node ended FAILED (the message says which)
 """
 from __future__ import annotations
 
+import contextlib
 import errno
 import functools
 import logging
@@ -315,9 +316,11 @@ class Supervisor:
                     self._stop_signal(signum)
             if before_start is not None:
                 before_start()
-            self.start_all()
+            with self._watchdog_deferred():
+                self.start_all()
             while not self.done():
-                self.loop.run_once()
+                with self._watchdog_deferred():   # one write for all the exits of a batch
+                    self.loop.run_once()
             # collect what the last exits left in the pipes (bounded: grandchildren may hold them)
             deadline = time.monotonic() + 1.0
             while self._open_pipes and time.monotonic() < deadline:
@@ -561,6 +564,10 @@ class Supervisor:
         if self.outputs[spec.name].files and self.log_dir and spec.log_name:
             return f"\nlog file: {os.path.join(self.log_dir, spec.log_name)}*.log"
         return ""
+
+    def _watchdog_deferred(self) -> contextlib.AbstractContextManager[None]:
+        return (self.watchdog.deferred() if self.watchdog is not None
+                else contextlib.nullcontext())
 
     def _set_timer(self, proc: ManagedProcess, delay: float, callback: Callable[[], None]) -> None:
         self._cancel_timer(proc)
