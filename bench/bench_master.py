@@ -13,8 +13,10 @@ between servers) and ``raw``: requests written by ``xmlrpc.client.dumps`` before
 starts, sent on one kept-alive HTTP/1.1 connection, the reply read up to its
 Content-Length and only its status code checked: about as little as a client can do, so
 these rows show what the servers themselves cost. Every measurement is taken ``--rounds``
-times, interleaved between the two masters; the tables show medians. Skipped with a message
-when /usr/bin/rosmaster is missing (orchestra's figures still print).
+times, interleaved between the two masters; the tables show medians of the wall-clock
+figures and of the master processes' own CPU time for the same calls (psutil; far less
+sensitive than wall clock to other load on a shared machine). Skipped with a message when
+/usr/bin/rosmaster is missing (orchestra's figures still print).
 
 Usage: ``python bench/bench_master.py [--quick] [--seconds 1.0] [--rounds 5] [--cpu N]``
 """
@@ -34,13 +36,15 @@ from collections.abc import Callable
 from urllib.parse import urlsplit
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import psutil  # noqa: E402
 import ros1  # noqa: E402
 
 PIN: list[str] = []
+TIMED_REPEATS = 3  # runs of each timed case per round (its CPU time: their mean)
 
 
-def rate(fn, seconds: float) -> float:
-    """Calls per second of ``fn`` over about ``seconds`` (after a short warm-up)."""
+def rate(fn, seconds: float) -> tuple[float, int]:
+    """(calls per second, calls made) of ``fn`` over about ``seconds`` (after a warm-up)."""
     for _ in range(20):
         fn()
     calls = 0
@@ -52,7 +56,7 @@ def rate(fn, seconds: float) -> float:
         calls += 50
         now = time.perf_counter()
         if now >= deadline:
-            return calls / (now - start)
+            return calls / (now - start), calls
 
 
 class RawClient:
@@ -136,6 +140,11 @@ class MasterProcess:
                     self.stop()
                     raise RuntimeError(f"{argv[0]} did not come up") from None
                 time.sleep(0.05)
+
+    def cpu_seconds(self) -> float:
+        """CPU time (user + system) the master process has used so far."""
+        times = psutil.Process(self.proc.pid).cpu_times()
+        return times.user + times.system
 
     def stop(self) -> None:
         ros1.kill_tree(self.proc.pid)
@@ -288,24 +297,46 @@ def main() -> None:
                  ("[raw] multicall of 1,000 setParam, ms", multicall_set_raw)]
         names += [name for name, _ in timed]
         results: dict[str, list[list[float]]] = {side: [[] for _ in names] for side in sides}
+        # the masters' own CPU time: per call (rate rows, us) or per run (timed rows, ms)
+        cpu: dict[str, list[list[float]]] = {side: [[] for _ in names] for side in sides}
         for round_no in range(args.rounds):
-            for side, (params, graph) in sides.items():   # interleaved
+            for side, masters in sides.items():   # interleaved
+                params, graph = masters
                 cases = rate_cases(params.uri, graph.uri, n)
                 for i, (_, fn) in enumerate(cases):
-                    results[side][i].append(rate(fn, seconds))
+                    before = sum(m.cpu_seconds() for m in masters)
+                    calls_per_s, calls = rate(fn, seconds)
+                    used = sum(m.cpu_seconds() for m in masters) - before
+                    results[side][i].append(calls_per_s)
+                    cpu[side][i].append(used / calls * 1e6)
                 for j, (_, run) in enumerate(timed):
                     uri = graph.uri if "register" in run.__name__ else params.uri
-                    results[side][len(cases) + j].append(
-                        run(uri, 1000, f"/r{round_no}/{j}") * 1e3)
+                    before = sum(m.cpu_seconds() for m in masters)
+                    for repeat in range(TIMED_REPEATS):   # CPU time is counted in 10 ms ticks
+                        results[side][len(cases) + j].append(
+                            run(uri, 1000, f"/r{round_no}/{j}/{repeat}") * 1e3)
+                    used = sum(m.cpu_seconds() for m in masters) - before
+                    cpu[side][len(cases) + j].append(used * 1e3 / TIMED_REPEATS)
     finally:
         for masters in sides.values():
             for master in masters:
                 master.stop()
 
+    _table(f"wall clock, median of {args.rounds} rounds", names, results)
+    print("ratio = orchestra / rosmaster (calls/s rows: higher is faster; ms rows: lower is "
+          "faster)")
+    cpu_names = [name.replace("calls/s", "master CPU us per call").replace(
+        ", ms", ", master CPU ms") for name in names]
+    _table(f"the master process's CPU time, median of {args.rounds} rounds", cpu_names, cpu)
+    print("ratio = orchestra / rosmaster (lower is cheaper; a master's calls/s on a CPU of "
+          "its own is 1e6 / us per call)")
+    print(ros1.load_average())
+
+
+def _table(title: str, names: list[str], results: dict[str, list[list[float]]]) -> None:
     width = max(len(name) for name in names)
     med = {side: [statistics.median(v) for v in values] for side, values in results.items()}
-    print(f"\n{'median of ' + str(args.rounds) + ' rounds':<{width}}  {'orchestra':>10}  "
-          f"{'rosmaster':>10}  {'ratio':>6}")
+    print(f"\n{title:<{width}}  {'orchestra':>10}  {'rosmaster':>10}  {'ratio':>6}")
     for i, name in enumerate(names):
         ours = med["orchestra"][i]
         if "rosmaster" in med:
@@ -313,9 +344,6 @@ def main() -> None:
             print(f"{name:<{width}}  {ours:10.1f}  {theirs:10.1f}  {ours / theirs:5.2f}x")
         else:
             print(f"{name:<{width}}  {ours:10.1f}")
-    print("ratio = orchestra / rosmaster (calls/s rows: higher is faster; ms rows: lower is "
-          "faster)")
-    print(ros1.load_average())
 
 
 if __name__ == "__main__":
