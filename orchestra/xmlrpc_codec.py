@@ -92,6 +92,19 @@ _TOKEN = re.compile(
     "|(?P<end_call>methodCall>)"
     "|(?P<end_response>methodResponse>)))"
     "|(?P<other>[^ \t\n]))")
+# A call whose arguments are all scalars (most calls a master gets), matched whole: its
+# values are then found in the params part by _FLAT_VALUE, no walk needed. Same subset and
+# spacing rules as the tokens above.
+_SCALAR_TYPES = ("string|int|i4|double|boolean|i8|i1|i2|biginteger|float|base64"
+                 "|dateTime\\.iso8601")
+_FLAT_CALL = re.compile(
+    "[ \t\n]*<methodCall>[ \t\n]*<methodName>([^<]*)</methodName>[ \t\n]*<params>("
+    "(?:[ \t\n]*<param>[ \t\n]*<value>(?:[ \t\n]*<(" + _SCALAR_TYPES + ")>[^<]*</\\3>"
+    "[ \t\n]*|[^<]*|[ \t\n]*<nil/>[ \t\n]*)</value>[ \t\n]*</param>)*"
+    ")[ \t\n]*</params>[ \t\n]*</methodCall>")
+_FLAT_VALUE = re.compile(
+    "<value>(?:[ \t\n]*<(" + _SCALAR_TYPES + ")>([^<]*)</\\1>[ \t\n]*|([^<]*)"
+    "|[ \t\n]*(<nil/>)[ \t\n]*)</value>")
 _T = _TOKEN.groupindex
 _TYPE, _TYPED, _UNTYPED, _NIL = _T["type"], _T["typed"], _T["untyped"], _T["nil"]
 _NAME, _METHOD = _T["name"], _T["method"]
@@ -160,6 +173,12 @@ def _loads_plain(data: bytes | bytearray) -> tuple[tuple[Any, ...], str | None] 
         if decl is None:
             return None
         start = decl.end()
+    flat = _FLAT_CALL.fullmatch(text, start)
+    if flat is not None:
+        name = flat[1]
+        return (tuple([_scalar(kind or None, typed, untyped, nil)
+                       for kind, typed, untyped, nil in _FLAT_VALUE.findall(flat[2])]),
+                _text(name) if "&" in name else name)
     value_token, array_token, struct_token = _T["value"], _T["array"], _T["struct"]
     param_token, end_param_token, end_array_token = _T["param"], _T["end_param"], _T["end_array"]
     member_token, end_member_token = _T["member"], _T["end_member"]
