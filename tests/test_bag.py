@@ -88,6 +88,17 @@ def test_killed_recording_loses_at_most_the_open_chunk_and_reindex_repairs_it(tm
     assert got == [_string(f"n {i}") for i in range(on_disk)]
 
 
+def test_blocks_reserved_ahead_neither_show_in_the_size_nor_stay_after_close(tmp_path):
+    """The writer reserves disk blocks past the end (fallocate, size kept): a killed
+    recording ends where its last chunk ends, and closing gives the reserve back."""
+    path = tmp_path / "reserved.bag"
+    w = _write(path, 400, close=False)
+    assert os.path.getsize(path) == w._good_end   # what a kill -9 leaves: no zeros after
+    w.close()
+    st = os.stat(path)
+    assert st.st_blocks * 512 < st.st_size + writer_mod.RESERVE_AHEAD // 4
+
+
 def test_reindex_drops_a_half_written_chunk(tmp_path):
     path = tmp_path / "cut.bag"
     _write(path, 400)

@@ -24,6 +24,10 @@ log = logging.getLogger(__name__)
 #: how often -a / -e ask the master for new topics
 DISCOVERY_PERIOD = 0.25
 
+#: messages up to this size are written by the thread that received them when the writer is
+#: idle; larger ones always go to the writer thread (see ``Recorder._on_message``)
+DIRECT_WRITE_MAX = 64 * 1024
+
 
 class RecordError(Exception):
     """Recording cannot start or cannot go on (no folder, disk full)."""
@@ -173,17 +177,21 @@ class Recorder:
             topic, AnyMsg, self._on_message, callback_args=topic, queue_size=0)
 
     def _on_message(self, msg, topic: str) -> None:
-        """A receive thread: stamp, then write at once when nothing is queued and nobody is
-        writing (no hand-over to another thread: what makes large messages fast), else
-        queue for the writer thread. Order is kept: the writer thread takes the write lock
-        before it takes a batch, and a direct write needs an empty queue."""
+        """A receive thread: stamp, then write a small message at once when nothing is
+        queued and nobody is writing (no hand-over to another thread: what makes small
+        messages fast), else queue for the writer thread. A large one (an image) always
+        goes to the writer: its file write (a few ms when the page cache is busy) then
+        runs while this thread receives the next one, as rosbag record's writer thread
+        does, instead of holding up the socket. Order is kept: the writer thread takes the
+        write lock before it takes a batch, and a direct write needs an empty queue."""
         from orchestra.node.rostime import get_rostime
         stamp = get_rostime().to_nsec()
         data = msg._buff
         with self._cond:
             if self.stopping.is_set():
                 return
-            direct = not self._queue and self._write_lock.acquire(blocking=False)
+            direct = (len(data) < DIRECT_WRITE_MAX and not self._queue
+                      and self._write_lock.acquire(blocking=False))
             if not direct:
                 self._enqueue((stamp, topic, msg._connection_header, data))
                 return

@@ -18,7 +18,7 @@ import logging
 import os
 from dataclasses import dataclass, field
 
-from orchestra.bag import chunkcodec
+from orchestra.bag import chunkcodec, preallocate
 from orchestra.bag.records import (
     MAGIC,
     U32,
@@ -38,6 +38,9 @@ _IOV_MAX = 1024
 
 #: rosbag record's default chunk size
 DEFAULT_CHUNK_SIZE = 768 * 1024
+
+#: blocks are reserved this far past the end of the file at a time (``preallocate``)
+RESERVE_AHEAD = 16 * 1024 * 1024
 
 
 class BagWriteError(Exception):
@@ -73,6 +76,7 @@ class BagWriter:
         self._infos: list[ChunkInfo] = []
         self._fd: int | None = None
         self._good_end = 0
+        self._reserved = 0  # blocks are reserved up to here (0: not yet, -1: cannot)
         self.messages = 0
         self.failed: OSError | None = None
 
@@ -150,6 +154,7 @@ class BagWriter:
                                 "size": U32.pack(chunk.length)})
         parts = [U32.pack(len(header)) + header + U32.pack(body_len), *body,
                  b"".join(encode_index(cid, entries) for cid, entries in chunk.entries.items())]
+        self._reserve(self._good_end + sum(len(p) for p in parts))
         try:
             self._write_parts(parts)
         except OSError as exc:
@@ -205,6 +210,18 @@ class BagWriter:
                               "repairs it", self.path, exc)
                     return
                 self._good_end = self._infos.pop().pos
+
+    def _reserve(self, end: int) -> None:
+        """Reserve blocks up to past ``end`` (see ``preallocate``); a failure only means
+        writes allocate their own (a full disk is met, and handled, by the write)."""
+        if self._reserved < 0 or end <= self._reserved:
+            return
+        assert self._fd is not None
+        start = max(self._reserved, self._good_end)
+        if preallocate.reserve(self._fd, start, end - start + RESERVE_AHEAD):
+            self._reserved = end + RESERVE_AHEAD
+        else:
+            self._reserved = -1
 
     def _write(self, blob: bytes) -> None:
         assert self._fd is not None
