@@ -151,6 +151,18 @@ def _orchestra_env(env: dict) -> dict:
     return {**env, "PYTHONPATH": str(REPO)}
 
 
+def _without_site_hooks(env: dict) -> tuple[list[str], dict]:
+    """argv prefix and ``env`` of orchestra run by ``python -S`` with site-packages on
+    PYTHONPATH: the same code and dependencies without this interpreter's ``.pth`` start-up
+    hooks (pip's editable-install finder, a certificate hook of the machine) that every
+    ``python`` here runs first and Debian's python3, which runs roslaunch, does not: about
+    what a plain ``pip install`` in a virtualenv gives (which keeps site's own ~2 ms)."""
+    import site
+
+    path = os.pathsep.join([str(REPO), *site.getsitepackages()])
+    return [sys.executable, "-S", "-m", "orchestra"], {**env, "PYTHONPATH": path}
+
+
 def compile_bytecode() -> None:
     """Byte-compile orchestra's modules, as ``pip install`` leaves them: with
     PYTHONDONTWRITEBYTECODE set (as on this machine) or a checkout that changed since it last
@@ -240,7 +252,7 @@ def bench_cases(samples: int, rounds: int, rows: list) -> None:
                  o_med / r_med, ""))
 
     sub_jobs = both[:samples]
-    o_sub, r_sub = [], []
+    o_sub, r_sub, bare_sub = [], [], []
     for i in sub_jobs:  # interleaved: each case through orchestra, then through roslaunch
         path, words, env = jobs[i]
         t, ok = _subprocess_time(_pinned([orchestra_script(), "launch", "--dump-params", path,
@@ -251,12 +263,19 @@ def bench_cases(samples: int, rounds: int, rows: list) -> None:
                                  ros1.base_env(**env))
         if ok:
             r_sub.append(t)
+        bare, bare_env = _without_site_hooks(env)
+        t, ok = _subprocess_time(_pinned([*bare, "launch", "--dump-params", path, *words]),
+                                 bare_env)
+        if ok:
+            bare_sub.append(t)
     rows.append((f"--dump-params, one process per case, median of {len(sub_jobs)}",
                  f"{statistics.median(o_sub) * 1e3:.0f} ms",
                  f"{statistics.median(r_sub) * 1e3:.0f} ms",
                  statistics.median(o_sub) / statistics.median(r_sub), ""))
     rows.append((f"  whole corpus, sum over the {len(sub_jobs)} cases", f"{sum(o_sub):.1f} s",
                  f"{sum(r_sub):.1f} s", sum(o_sub) / sum(r_sub), "<= 0.2x"))
+    rows.append(("  same, orchestra without this python's .pth hooks (python -S)",
+                 f"{sum(bare_sub):.1f} s", f"{sum(r_sub):.1f} s", sum(bare_sub) / sum(r_sub), ""))
 
 
 ONE_NODE = """<launch>
@@ -274,6 +293,7 @@ def bench_startup(samples: int, rows: list) -> None:
         one.write_text(ONE_NODE)
         env = _orchestra_env(dict(os.environ))
         runs = {"python -c pass": [sys.executable, "-c", "pass"],
+                "python -S -c pass": [sys.executable, "-S", "-c", "pass"],
                 "orchestra --help": [orchestra_script(), "--help"],
                 "orchestra launch --dump-params one_node.launch":
                     [orchestra_script(), "launch", "--dump-params", str(one)]}
@@ -286,7 +306,10 @@ def bench_startup(samples: int, rows: list) -> None:
                     return
                 times[what].append(took)
     base = statistics.median(times["python -c pass"])
-    for what in list(runs)[1:]:
+    print(f"start-up: python -c pass {base * 1e3:.0f} ms, of which this interpreter's site "
+          "start-up (its .pth hooks: the editable-install finder, ...) "
+          f"{(base - statistics.median(times['python -S -c pass'])) * 1e3:.0f} ms")
+    for what in list(runs)[2:]:
         ours = statistics.median(times[what])
         rows.append((f"{what} (median of {samples})", f"{ours * 1e3:.0f} ms",
                      f"{base * 1e3:.0f} ms", ours / base, "<= 2x"))
