@@ -15,13 +15,12 @@ from __future__ import annotations
 
 import os
 import sys
-from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 
-@dataclass(frozen=True)
-class OutputOption:
-    """One option of ``orchestra launch``'s print-and-exit modes."""
+class OutputOption(NamedTuple):
+    """One option of ``orchestra launch``'s print-and-exit modes. (A NamedTuple: it is built
+    on this start-up path, where a frozen dataclass costs ~0.4 ms to create.)"""
 
     flag: str
     #: the click parameter name (the keyword of the command's callback)

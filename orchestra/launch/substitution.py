@@ -18,7 +18,6 @@ from collections.abc import Callable, Mapping
 from typing import Any, Protocol
 
 from orchestra.errors import OrchestraError, clip
-from orchestra.launch.evaluate import EvalError, evaluate
 from orchestra.names import anonymous_name
 
 COMMANDS = ("find", "env", "optenv", "dirname", "anon", "arg")
@@ -220,6 +219,9 @@ def _convert_arg(text: str) -> Any:
 
 def _eval(expr: str, scope: Scope) -> str:
     """``$(eval EXPR)`` through the safe evaluator, with the launch functions of ``scope``."""
+    # imported here: the evaluator's module (policy, grammar) is a millisecond of every
+    # launch's start-up that only files with $(eval) need
+    from orchestra.launch.evaluate import EvalError, evaluate
 
     def arg(name: str) -> Any:
         # like a bare name, arg('x') is typed: 'false' is False, '3' is 3
