@@ -270,6 +270,32 @@ def test_a_service_serves_many_connections_open_at_once(nodes, master, monkeypat
             sock.close()
 
 
+def test_a_plain_proxy_follows_its_service_when_it_moves_or_goes(nodes, master, monkeypatch):
+    """Every plain call looks the service up (rospy's rule), however the connection is
+    opened: a service restarted on another port is found there, one that is gone is
+    ``unavailable``, one that is back is called again."""
+    from orchestra.node.exceptions import ServiceException
+    from orchestra.node.msg import Registry
+    from orchestra.node.services import ServiceProxy
+
+    monkeypatch.setenv("ROS_PACKAGE_PATH", nodes.env["ROS_PACKAGE_PATH"])
+    monkeypatch.setenv("ROS_MASTER_URI", master.uri)
+    cls = Registry().service_class("test_msgs/AddTwoInts")
+    first = nodes.start("adder.py", "add")
+    first.ready()
+    proxy = ServiceProxy("/add", cls)  # not a node: rospy allows that too
+    assert proxy(a=1, b=2).sum == 3
+    where = OneShotProxy(master.uri).lookupService("/test", "/add")[2]
+    first.signal(signal.SIGTERM)
+    assert first.wait() == 0
+    with pytest.raises(ServiceException, match=r"service \[/add\] unavailable"):
+        proxy(a=1, b=1)
+    second = nodes.start("adder.py", "add")
+    second.ready()
+    assert OneShotProxy(master.uri).lookupService("/test", "/add")[2] != where
+    assert [proxy(a=i, b=10).sum for i in range(3)] == [10, 11, 12]
+
+
 def test_service_proxy_from_a_node_process(nodes):
     nodes.start("adder.py", "math/add").ready()
     caller = nodes.start("caller.py", "math/add")

@@ -8,6 +8,7 @@ one call; a persistent one carries calls until the client closes it.
 """
 from __future__ import annotations
 
+import functools
 import logging
 import os
 import socket
@@ -171,12 +172,24 @@ class Service:
 
 
 class _Connection:
-    """A client's connection to a service: the socket, its reader, the server's header."""
+    """A client's connection to a service at ``uri``: the socket, its reader and, once the
+    server has answered our header, the server's header."""
 
-    def __init__(self, sock: socket.socket, reader: tcpros.Reader, header: dict[str, str]):
+    def __init__(self, uri: str, sock: socket.socket):
+        self.uri = uri
         self.sock = sock
-        self.reader = reader
+        self.reader = tcpros.Reader(sock)
+        self.header: dict[str, str] = {}
+
+    def greeted(self, name: str) -> _Connection:
+        """Read the server's header (ours went out on connecting); a refusal (an ``error``
+        header) is a ``ServiceException``; a broken connection raises as it comes."""
+        header = self.reader.header()
+        if "error" in header:
+            self.close()
+            raise ServiceException(f"service [{name}] refused the connection: {header['error']}")
         self.header = header
+        return self
 
     def call(self, body: bytes | bytearray) -> tuple[bool, bytes]:
         tcpros.send_message(self.sock, body)
@@ -186,29 +199,79 @@ class _Connection:
         self.sock.close()
 
 
-def _open(master, name: str, hello: bytes, timeout: float | None = 10.0) -> _Connection:
-    """Look ``name`` up (every time, as rospy does: the service may have moved), connect
-    and exchange headers; ``hello`` is our encoded header."""
+def _is_local(uri: str) -> bool:
+    """Whether a ``rosrpc://`` URI names this machine (loopback or our host name)."""
+    host = tcpros.parse_rosrpc_uri(uri)[0]
+    return host == "localhost" or host.startswith("127.") or host in ("::1", _hostname())
+
+
+@functools.cache
+def _hostname() -> str:
+    return socket.gethostname()
+
+
+def _lookup(master, name: str) -> str:
     try:
-        uri = master.call("lookupService", name)
+        return master.call("lookupService", name)
     except MasterError as exc:
         raise ServiceException(f"service [{name}] unavailable") from exc
+
+
+def _dial(uri: str, name: str, hello: bytes, timeout: float | None = 10.0) -> _Connection:
+    """Connect to the service at ``uri`` and send our header ``hello``."""
     host, port = tcpros.parse_rosrpc_uri(uri)
     try:
         sock = tcpros.connect(host, port, timeout=timeout)
     except OSError as exc:
         raise ServiceException(f"unable to connect to service [{name}] at {uri}: {exc}") from exc
-    reader = tcpros.Reader(sock)
     try:
         sock.sendall(hello)
-        header = reader.header()
-    except (OSError, TransportException) as exc:
+    except OSError as exc:
         sock.close()
         raise ServiceException(f"service [{name}]: connection failed: {exc}") from exc
-    if "error" in header:
-        sock.close()
-        raise ServiceException(f"service [{name}] refused the connection: {header['error']}")
-    return _Connection(sock, reader, header)
+    return _Connection(uri, sock)
+
+
+def _greet(conn: _Connection, name: str) -> _Connection:
+    try:
+        return conn.greeted(name)
+    except (OSError, TransportException) as exc:
+        conn.close()
+        raise ServiceException(f"service [{name}]: connection failed: {exc}") from exc
+
+
+def _open(master, name: str, hello: bytes, last_uri: str | None) -> _Connection:
+    """Look ``name`` up (every call, as rospy does: the service may have moved) and
+    connect to it, headers exchanged.
+
+    The master's answer is a round trip of its own, as long as connecting and exchanging
+    headers; so when the service was found at ``last_uri`` before, on this machine, that
+    connection is opened and greeted first and the server answers our header while the
+    master answers the lookup. Used when the master names the same place; closed unused
+    otherwise (the service moved or is gone: the result is then exactly that of looking up
+    first). Only on this machine, where a connect is answered at once (accepted or
+    refused): a remote host that went away would hold the call up until the connect gave
+    up, even when the master knows the service is elsewhere now."""
+    early = None
+    if last_uri is not None and _is_local(last_uri):
+        try:
+            early = _dial(last_uri, name, hello)
+        except (ServiceException, TransportException):
+            early = None  # not there any more: the lookup decides
+    try:
+        uri = _lookup(master, name)
+    except BaseException:
+        if early is not None:
+            early.close()
+        raise
+    if early is not None:
+        if early.uri == uri:
+            try:
+                return early.greeted(name)
+            except (OSError, TransportException):
+                pass  # broke while we looked it up: a fresh connection decides
+        early.close()
+    return _greet(_dial(uri, name, hello), name)
 
 
 class NoNode:
@@ -259,6 +322,7 @@ class ServiceProxy:
             fields["persistent"] = "1"
         self._hello = tcpros.encode_header(fields)
         self._conn: _Connection | None = None
+        self._last_uri: str | None = None  # where the service was found last
         self._lock = threading.Lock()
 
     def wait_for_service(self, timeout: float | None = None) -> None:
@@ -277,7 +341,13 @@ class ServiceProxy:
             request = self.request_class(*args, **kwargs)
         body = request.serialize_bytes()
         with self._lock:
-            conn = self._conn or _open(self._rt.master, self.name, self._hello)
+            conn = self._conn
+            if conn is None:
+                # a failed lookup or connection forgets where the service was: a node that
+                # took over the port then sees at most one early connection, not one a call
+                last, self._last_uri = self._last_uri, None
+                conn = _open(self._rt.master, self.name, self._hello, last)
+                self._last_uri = conn.uri
             try:
                 ok, reply = conn.call(body)
             except (OSError, TransportException) as exc:
