@@ -18,6 +18,7 @@ import pytest
 
 from orchestra.supervise.output import Screen
 from orchestra.supervise.process import OutputMode, ProcessSpec, RestartPolicy, State, restart_delay
+from orchestra.supervise.reaper import setpriv_prefix
 from orchestra.supervise.supervisor import Supervisor
 
 pytestmark = pytest.mark.timeout(60)
@@ -415,3 +416,53 @@ def test_without_pidfd_a_waiter_thread_reports_exits(tmp_path, monkeypatch):
     assert result.exit_code == 0
     assert sup.procs[0].state == State.EXITED and sup.procs[0].exit_code == -signal.SIGINT
     assert screen.out.getvalue().count(b"[/crashy] bye\n") >= 3
+
+
+def test_spawner_gives_outcomes_in_call_order_with_errors_as_outcomes():
+    from orchestra.supervise.spawner import Spawner
+
+    def fail() -> int:
+        raise OSError("no such program")
+
+    spawner = Spawner(max_threads=4)
+    try:
+        outcomes = spawner.run([lambda: 1, fail, lambda: 3, lambda: 4, lambda: 5])
+    finally:
+        spawner.close()
+    assert [o.value for o in outcomes] == [1, None, 3, 4, 5]
+    assert isinstance(outcomes[1].error, OSError)
+    assert [o.error for o in outcomes if o is not outcomes[1]] == [None] * 4
+
+
+@pytest.mark.skipif(not setpriv_prefix(), reason="util-linux setpriv --pdeathsig not available")
+def test_processes_spawned_together_live_until_the_spawner_closes(tmp_path):
+    """The parent-death signal follows the thread that forked a child: the spawner's threads
+    must outlive what they started (and closing them is what a dead parent thread means)."""
+    from orchestra.supervise.spawner import Spawner
+
+    spawner = Spawner(max_threads=3)
+    popens = spawner.run([
+        lambda: subprocess.Popen([*setpriv_prefix(), "sleep", "30"], cwd=tmp_path)
+        for _ in range(3)])
+    procs = [outcome.value for outcome in popens]
+    try:
+        # setpriv has set the parent-death signal once it exec'd sleep
+        deadline = time.monotonic() + 10
+        while not all(_exe(proc.pid).endswith("/sleep") for proc in procs):
+            assert time.monotonic() < deadline, "setpriv did not exec sleep"
+            time.sleep(0.01)
+        assert all(proc.poll() is None for proc in procs)
+        spawner.close()      # the forking threads end: their children get SIGKILL
+        for proc in procs:
+            assert proc.wait(timeout=10) == -signal.SIGKILL
+    finally:
+        for proc in procs:
+            proc.kill()
+            proc.wait()
+
+
+def _exe(pid: int) -> str:
+    try:
+        return os.readlink(f"/proc/{pid}/exe")
+    except OSError:
+        return ""

@@ -74,8 +74,15 @@ class Spawner:
         while len(self._threads) < min(self.max_threads, len(calls)):
             thread = threading.Thread(target=self._serve, daemon=True,
                                       name=f"{self._name} {len(self._threads)}")
-            thread.start()
+            try:
+                thread.start()
+            except RuntimeError:   # no more threads allowed (RLIMIT_NPROC): use those we have
+                break
             self._threads.append(thread)
+        if not self._threads:
+            for index, call in enumerate(calls):
+                task(index, call)
+            return outcomes
         for index, call in enumerate(calls):
             self._work.put(functools.partial(task, index, call))
         done.wait()
