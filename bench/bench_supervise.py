@@ -118,7 +118,7 @@ def cold_start_and_idle_cpu(n: int, idle: float) -> dict[str, float]:
         before = ps.cpu_times()
         time.sleep(idle)
         after = ps.cpu_times()
-        cpu = (after.user + after.system - before.user - before.system) / idle * 100
+        cpu = max(0.0, (after.user + after.system - before.user - before.system) / idle * 100)
         t0 = time.perf_counter()
         proc.send_signal(signal.SIGINT)
         proc.wait(timeout=60)
