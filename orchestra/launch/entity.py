@@ -35,7 +35,7 @@ class KnownPositions:
         return self.attributes.get(name)
 
 
-@dataclass
+@dataclass(slots=True)
 class Entity:
     """A tag with its attributes (name -> raw string, in file order), children and text.
 

@@ -157,9 +157,8 @@ def _find(resolved: str, body: str, pkg_args: list[str]) -> str:
     return before + pkg_dir + rest
 
 
-def _first_pass(resolved: str, body: str, words: list[str], scope: Scope) -> str:
+def _first_pass(resolved: str, token: str, words: list[str], scope: Scope) -> str:
     command, args = words[0], words[1:]
-    token = f"$({body})"
     if command == "env":
         return resolved.replace(token, _env(args[0]))
     if command == "optenv":
@@ -178,22 +177,43 @@ def _first_pass(resolved: str, body: str, words: list[str], scope: Scope) -> str
     return resolved
 
 
+# A text's groups, checked: ``(token, words)`` per group, or None for a whole-value
+# ``$(eval)``. The same few texts (``$(arg x)``, ``$(find pkg)/...``) recur on every element
+# of a file, so each text is scanned once; only texts that parse are kept, and the table is
+# emptied when it grows past _PARSED_LIMIT distinct texts.
+_PARSED: dict[str, list[tuple[str, list[str]]] | None] = {}
+_PARSED_LIMIT = 4096
+
+
+def _parse(text: str) -> list[tuple[str, list[str]]] | None:
+    found = _PARSED.get(text, False)
+    if found is not False:
+        return found  # type: ignore[return-value]
+    if eval_expression(text) is not None:
+        parsed = None
+    else:
+        parsed = []
+        for body in collect(text):
+            problem = body_problem(body)
+            if problem is not None:
+                raise SubstitutionError(problem)
+            parsed.append((f"$({body})", words(body)))
+    if len(_PARSED) >= _PARSED_LIMIT:
+        _PARSED.clear()
+    _PARSED[text] = parsed
+    return parsed
+
+
 def resolve(text: str | None, scope: Scope) -> str | None:
     """``text`` with every substitution arg evaluated; ``None`` stays ``None``."""
     if not text or "$" not in text:
         return text
-    expression = eval_expression(text)
-    if expression is not None:
-        return _eval(expression, scope)
-    parsed = []
-    for body in collect(text):
-        problem = body_problem(body)
-        if problem is not None:
-            raise SubstitutionError(problem)
-        parsed.append((body, words(body)))
+    parsed = _parse(text)
+    if parsed is None:
+        return _eval(text[7:-1], scope)
     resolved = text
-    for body, parts in parsed:
-        resolved = _first_pass(resolved, body, parts, scope)
+    for token, parts in parsed:
+        resolved = _first_pass(resolved, token, parts, scope)
     if "$" in resolved:
         # $(find) last; what the first pass left (from arg values) is only checked for
         # unknown commands, as roslaunch does

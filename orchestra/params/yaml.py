@@ -126,7 +126,11 @@ def load_yaml_value(text: str, filename: str = "<yaml>") -> Any:
         node = loader.get_single_node()
         if node is None:
             return None
-        _check_bounds(node, filename)
+        if _check_bounds(node, filename):
+            try:
+                return _construct_plain(loader, node)
+            except Exception:  # noqa: BLE001 - PyYAML's own path below raises it as it does
+                pass
         return loader.construct_document(node)
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
@@ -145,8 +149,9 @@ def load_yaml_value(text: str, filename: str = "<yaml>") -> Any:
         loader.dispose()
 
 
-def _check_bounds(root: yaml.Node, filename: str) -> None:
-    """Refuse nesting deeper than ``MAX_DEPTH`` and oversized integers, at their position.
+def _check_bounds(root: yaml.Node, filename: str) -> bool:
+    """Refuse nesting deeper than ``MAX_DEPTH`` and oversized integers, at their position;
+    whether the document is *plain* (see ``_construct_plain``).
 
     Aliases make the node tree a graph: each node is visited once (its deepest level found
     via the order of a depth-first walk is enough to bound what construction recurses
@@ -154,24 +159,63 @@ def _check_bounds(root: yaml.Node, filename: str) -> None:
     """
     stack: list[tuple[yaml.Node, int]] = [(root, 1)]
     seen: dict[int, int] = {}
+    plain = True
     while stack:
         node, depth = stack.pop()
         if depth > MAX_DEPTH:
             raise RosparamYamlError(f"nested more than {MAX_DEPTH} levels deep",
                                     _node_location(filename, node))
-        if seen.get(id(node), 0) >= depth:
-            continue
+        known = seen.get(id(node))
+        if known is not None:
+            plain = False  # an alias: the same object in two places
+            if known >= depth:
+                continue
         seen[id(node)] = depth
+        tag = node.tag
         if isinstance(node, yaml.ScalarNode):
-            if node.tag == _INT_TAG and len(node.value) > MAX_INT_TEXT:
+            if tag == _INT_TAG and len(node.value) > MAX_INT_TEXT:
                 raise RosparamYamlError(f"integer of {len(node.value)} characters (at most "
                                         f"{MAX_INT_TEXT})", _node_location(filename, node))
+            if tag not in _PLAIN_SCALAR_TAGS:
+                plain = False
         elif isinstance(node, yaml.SequenceNode):
+            if tag != _SEQ_TAG:
+                plain = False
             stack.extend((child, depth + 1) for child in node.value)
         elif isinstance(node, yaml.MappingNode):
+            if tag != _MAP_TAG:
+                plain = False
             for key, value in node.value:
+                if key.tag not in _PLAIN_SCALAR_TAGS or not isinstance(key, yaml.ScalarNode):
+                    plain = False  # a merge (<<) or value (=) key, or a collection as a key
                 stack.append((key, depth + 1))
                 stack.append((value, depth + 1))
+    return plain
+
+
+_STR_TAG = "tag:yaml.org,2002:str"
+_SEQ_TAG = "tag:yaml.org,2002:seq"
+_MAP_TAG = "tag:yaml.org,2002:map"
+_PLAIN_SCALAR_TAGS = frozenset({_STR_TAG, _INT_TAG, "tag:yaml.org,2002:float",
+                                "tag:yaml.org,2002:bool", "tag:yaml.org,2002:null"})
+
+
+def _construct_plain(loader: RosparamLoader, node: yaml.Node) -> Any:
+    """What ``loader.construct_document(node)`` builds, for a plain document: every node
+    written once (no aliases), only maps, sequences, strings, numbers, booleans and nulls,
+    scalar keys. Nearly every rosparam file is one; PyYAML's constructor spends most of its
+    time on what such a document never needs (two-phase construction for recursive
+    structures, merge keys, per-object bookkeeping). A scalar it would refuse raises here,
+    and the caller then lets PyYAML's constructor raise its error as before."""
+    tag = node.tag
+    if tag == _STR_TAG:
+        return node.value
+    if tag == _MAP_TAG:
+        return {_construct_plain(loader, key): _construct_plain(loader, value)
+                for key, value in node.value}
+    if tag == _SEQ_TAG:
+        return [_construct_plain(loader, child) for child in node.value]
+    return loader.yaml_constructors[tag](loader, node)
 
 
 def _node_location(filename: str, node: yaml.Node) -> Location:
