@@ -126,9 +126,10 @@ def load_yaml_value(text: str, filename: str = "<yaml>") -> Any:
         node = loader.get_single_node()
         if node is None:
             return None
-        if _check_bounds(node, filename):
+        shared = _check_bounds(node, filename)
+        if shared is not None:
             try:
-                return _construct_plain(loader, node)
+                return _PlainBuilder(loader, shared).build(node)
             except Exception:  # noqa: BLE001 - PyYAML's own path below raises it as it does
                 pass
         return loader.construct_document(node)
@@ -149,9 +150,10 @@ def load_yaml_value(text: str, filename: str = "<yaml>") -> Any:
         loader.dispose()
 
 
-def _check_bounds(root: yaml.Node, filename: str) -> bool:
-    """Refuse nesting deeper than ``MAX_DEPTH`` and oversized integers, at their position;
-    whether the document is *plain* (see ``_construct_plain``).
+def _check_bounds(root: yaml.Node, filename: str) -> set[int] | None:
+    """Refuse nesting deeper than ``MAX_DEPTH`` and oversized integers, at their position.
+    For a *plain* document (see ``_PlainBuilder``), the ids of the nodes an alias names
+    again; None for any other document.
 
     Aliases make the node tree a graph: each node is visited once (its deepest level found
     via the order of a depth-first walk is enough to bound what construction recurses
@@ -159,6 +161,7 @@ def _check_bounds(root: yaml.Node, filename: str) -> bool:
     """
     stack: list[tuple[yaml.Node, int]] = [(root, 1)]
     seen: dict[int, int] = {}
+    shared: set[int] = set()
     plain = True
     while stack:
         node, depth = stack.pop()
@@ -167,7 +170,7 @@ def _check_bounds(root: yaml.Node, filename: str) -> bool:
                                     _node_location(filename, node))
         known = seen.get(id(node))
         if known is not None:
-            plain = False  # an alias: the same object in two places
+            shared.add(id(node))  # named again by an alias: one object in both places
             if known >= depth:
                 continue
         seen[id(node)] = depth
@@ -190,7 +193,7 @@ def _check_bounds(root: yaml.Node, filename: str) -> bool:
                     plain = False  # a merge (<<) or value (=) key, or a collection as a key
                 stack.append((key, depth + 1))
                 stack.append((value, depth + 1))
-    return plain
+    return shared if plain else None
 
 
 _STR_TAG = "tag:yaml.org,2002:str"
@@ -200,22 +203,39 @@ _PLAIN_SCALAR_TAGS = frozenset({_STR_TAG, _INT_TAG, "tag:yaml.org,2002:float",
                                 "tag:yaml.org,2002:bool", "tag:yaml.org,2002:null"})
 
 
-def _construct_plain(loader: RosparamLoader, node: yaml.Node) -> Any:
-    """What ``loader.construct_document(node)`` builds, for a plain document: every node
-    written once (no aliases), only maps, sequences, strings, numbers, booleans and nulls,
-    scalar keys. Nearly every rosparam file is one; PyYAML's constructor spends most of its
-    time on what such a document never needs (two-phase construction for recursive
-    structures, merge keys, per-object bookkeeping). A scalar it would refuse raises here,
-    and the caller then lets PyYAML's constructor raise its error as before."""
-    tag = node.tag
-    if tag == _STR_TAG:
-        return node.value
-    if tag == _MAP_TAG:
-        return {_construct_plain(loader, key): _construct_plain(loader, value)
-                for key, value in node.value}
-    if tag == _SEQ_TAG:
-        return [_construct_plain(loader, child) for child in node.value]
-    return loader.yaml_constructors[tag](loader, node)
+class _PlainBuilder:
+    """What ``loader.construct_document(node)`` builds, for a plain document: only maps,
+    sequences, strings, numbers, booleans and nulls, scalar keys, no merge keys (aliases
+    are fine: a node named again gives the same object, as PyYAML's constructor does).
+    Nearly every rosparam file is one; PyYAML's constructor spends most of its time on what
+    such a document never needs (two-phase construction for recursive structures, merge
+    keys, per-object bookkeeping). A scalar it would refuse raises here, and the caller
+    then lets PyYAML's constructor raise its error as before."""
+
+    def __init__(self, loader: RosparamLoader, shared: set[int]):
+        self.constructors = loader.yaml_constructors
+        self.loader = loader
+        self.shared = shared
+        self.built: dict[int, Any] = {}
+
+    def build(self, node: yaml.Node) -> Any:
+        if self.shared and id(node) in self.shared:
+            found = self.built.get(id(node), self)
+            if found is self:
+                found = self.built[id(node)] = self._build(node)
+            return found
+        return self._build(node)
+
+    def _build(self, node: yaml.Node) -> Any:
+        tag = node.tag
+        if tag == _STR_TAG:
+            return node.value
+        if tag == _MAP_TAG:
+            build = self.build
+            return {build(key): build(value) for key, value in node.value}
+        if tag == _SEQ_TAG:
+            return [self.build(child) for child in node.value]
+        return self.constructors[tag](self.loader, node)
 
 
 def _node_location(filename: str, node: yaml.Node) -> Location:
