@@ -21,13 +21,22 @@ def clip(text: str, limit: int = MAX_QUOTED) -> str:
     return f"{text[:limit]}... ({len(text)} chars)"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class Location:
     """Where something was written: a file and, when known, a line and column."""
 
     file: str
     line: int | None = None
     column: int | None = None
+
+    def __init__(self, file: str, line: int | None = None, column: int | None = None):
+        # Frozen: the fields are written once, here, straight into the instance's dict. The
+        # generated __init__ of a frozen dataclass goes through object.__setattr__ per field,
+        # twice the cost, and every element of every launch file read gets a Location.
+        fields = self.__dict__
+        fields["file"] = file
+        fields["line"] = line
+        fields["column"] = column
 
     def __str__(self) -> str:
         text = self.file

@@ -129,49 +129,44 @@ def _decode(data: bytes) -> str:
         return data.decode("latin-1")  # positions of ASCII markup stay right
 
 
-# Documents without namespaces (nearly all) skip the spelling of namespaced names per
-# element. A name is only in a namespace under an ``xmlns`` declaration or with the
-# predeclared ``xml:`` prefix, both written literally (names hold no references), so the
-# bytes of a document in an ASCII-compatible encoding tell; others (UTF-16/32, EBCDIC)
-# ask libxml2.
-_HAS_NAMESPACED_NAME = "boolean(//*[namespace-uri()!=''] | //@*[namespace-uri()!=''])"
+def _prefixes_possible(data: bytes | None) -> bool:
+    """Whether an attribute of the document may have a namespace prefix (``a:b``): only
+    prefixed attribute names are in a namespace (a default ``xmlns`` applies to tags, which
+    say so themselves), and names are written literally, so in an ASCII-compatible
+    encoding a document without a ``:`` byte has none. Others (UTF-16/32, EBCDIC): maybe."""
+    if data is None:
+        return True
+    head = data[3:64] if data.startswith(b"\xef\xbb\xbf") else data[:64]
+    head = head.lstrip(b" \t\r\n")
+    return b":" in data or head[:1] != b"<" or head[1:2] == b"\x00"
 
 
-def _namespaced(tree: etree._Element, data: bytes | None) -> bool:
-    if data is not None:
-        head = data[3:64] if data.startswith(b"\xef\xbb\xbf") else data[:64]
-        head = head.lstrip(b" \t\r\n")
-        if head[:1] == b"<" and head[1:2] != b"\x00":
-            return b"xmlns" in data or b"xml:" in data
-    return bool(tree.xpath(_HAS_NAMESPACED_NAME))
-
-
-class _Walk:
-    """One pass over a parsed document's elements, in document order, building Entities.
+def _entities(start: etree._Element, filename: str, document: _Document | None,
+              prefixes: bool, first_index: int) -> tuple[Entity, int, int]:
+    """The Entity of ``start`` and its subtree, in one pass over the elements in document
+    order; and how many elements and ``<launch>`` elements were seen.
 
     Each element's attributes, text pieces and line are read once (lxml's property access
-    is most of the cost); positions are only recorded as the element's index, resolved by
-    ``_Document`` when asked for."""
+    is most of the cost); positions are only recorded as the element's index in the
+    document, resolved by ``_Document`` when asked for."""
+    count = first_index   # the index of the next element
+    launches = 0
 
-    def __init__(self, filename: str, document: _Document | None, namespaced: bool):
-        self.filename = filename
-        self.document = document
-        self.namespaced = namespaced
-        self.count = 0      # elements visited, the index of the next one
-        self.launches = 0   # <launch> elements among them
-
-    def entity(self, element: etree._Element) -> Entity:
-        index = self.count
-        self.count = index + 1
+    def entity(element: etree._Element) -> Entity:
+        nonlocal count, launches
+        index = count
+        count = index + 1
         tag = element.tag
         if tag == "launch":
-            self.launches += 1
+            launches += 1
+        elif tag[0] == "{":
+            tag = _qualified(element, tag)
         children = []
         text = element.text
         pieces = None
         for child in element:
             if child.tag.__class__ is str:
-                children.append(self.entity(child))
+                children.append(entity(child))
             tail = child.tail
             if tail:
                 if pieces is None:
@@ -180,38 +175,36 @@ class _Walk:
         if pieces is not None:
             text = "".join(pieces)
         attributes = dict(element.items())
-        if self.namespaced:
-            if any(k[0] == "{" for k in attributes):
-                attributes = {_qualified(element, k): v for k, v in attributes.items()}
-            if tag[0] == "{":
-                tag = _qualified(element, tag)
-        location = Location(self.filename, element.sourceline)
-        positions = None
-        if self.document is not None:
-            positions = _ElementPositions(self.document, index, location)
+        if prefixes:
+            for name in attributes:
+                if name[0] == "{":
+                    attributes = {_qualified(element, k): v for k, v in attributes.items()}
+                    break
+        location = Location(filename, element.sourceline)
+        positions = None if document is None else _ElementPositions(document, index, location)
         return Entity(tag, attributes, children, text or None, location, positions)
+
+    root = entity(start)
+    return root, count - first_index, launches
 
 
 def _root(tree: etree._Element, filename: str, data: bytes | None = None) -> Entity:
-    namespaced = _namespaced(tree, data)
+    prefixes = _prefixes_possible(data)
     if tree.tag == "launch":
         # the usual document: the walk from the root sees every element
-        start, elements = tree, None
+        start, first, elements = tree, 0, None
     else:
         found = [el for el in tree.iter() if isinstance(el.tag, str)]
         launches = [i for i, el in enumerate(found) if el.tag == "launch"]
         if len(launches) != 1:
             raise _launch_count_error(len(launches), filename)
-        start, elements = found[launches[0]], len(found)
+        start, first, elements = found[launches[0]], launches[0], len(found)
     document = _Document(data, filename, elements or 0) if data is not None else None
-    walk = _Walk(filename, document, namespaced)
-    if elements is not None:
-        walk.count = launches[0]
-    root = walk.entity(start)
-    if walk.launches != 1:
-        raise _launch_count_error(walk.launches, filename)
+    root, seen, launch_count = _entities(start, filename, document, prefixes, first)
+    if launch_count != 1:
+        raise _launch_count_error(launch_count, filename)
     if document is not None and elements is None:
-        document.elements = walk.count
+        document.elements = seen
     return root
 
 
