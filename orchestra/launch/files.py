@@ -35,10 +35,16 @@ def _stub_target(path: str, data: bytes) -> str | None:
 def _read_regular(path: str) -> bytes:
     """A regular file's bytes, at most ``MAX_FILE_BYTES``: a launch file naming /dev/zero or a
     FIFO must get an error, not exhaust memory or block forever."""
-    if not stat.S_ISREG(os.stat(path).st_mode):
+    info = os.stat(path)
+    if not stat.S_ISREG(info.st_mode):
         raise OSError(errno.EINVAL, "not a regular file", path)
     with open(path, "rb") as fh:
-        data = fh.read(MAX_FILE_BYTES + 1)
+        # sized by the stat: read(n) allocates n bytes first, and a MAX_FILE_BYTES buffer
+        # per file costs more than reading a launch file; a file that grew since (or a
+        # /proc file, size 0) is read on up to the limit
+        data = fh.read(min(info.st_size, MAX_FILE_BYTES) + 1)
+        if len(data) > info.st_size:
+            data += fh.read(MAX_FILE_BYTES + 1 - len(data))
     if len(data) > MAX_FILE_BYTES:
         raise OSError(errno.EFBIG, f"larger than {MAX_FILE_BYTES // 2**20} MiB", path)
     return data

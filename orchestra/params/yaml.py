@@ -89,9 +89,28 @@ MAX_INT_TEXT = 1300
 _INT_TAG = "tag:yaml.org,2002:int"
 
 
+_resolve_tag = yaml.resolver.BaseResolver.resolve
+
+
 class RosparamLoader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):  # type: ignore[misc]
     """PyYAML's safe loader (libyaml-backed when available: same results, much faster) plus
     rosparam's angle tags; a subclass, so the global loaders stay untouched."""
+
+    def __init__(self, stream: Any):
+        super().__init__(stream)
+        self._scalar_tags: dict[tuple[str, Any], str] = {}
+
+    def resolve(self, kind: type, value: Any, implicit: Any) -> Any:
+        # a scalar's tag depends on its text and quoting alone (this loader has no path
+        # resolvers), and keys and values recur throughout a document: each text is matched
+        # against the implicit resolvers' patterns once per document
+        if kind is not yaml.ScalarNode:
+            return _resolve_tag(self, kind, value, implicit)
+        key = (value, implicit)
+        tag = self._scalar_tags.get(key)
+        if tag is None:
+            tag = self._scalar_tags[key] = _resolve_tag(self, kind, value, implicit)
+        return tag
 
     def construct_object(self, node: yaml.Node, deep: bool = False) -> Any:
         # a constructor's own ValueError (an impossible timestamp...) carries no position:
@@ -126,6 +145,11 @@ def load_yaml_value(text: str, filename: str = "<yaml>") -> Any:
         node = loader.get_single_node()
         if node is None:
             return None
+        if "*" not in text:  # no alias can name a node twice: one pass checks and builds
+            try:
+                return _PlainBuilder(loader, set()).checked(node, 1)
+            except Exception:  # noqa: BLE001 - anything else: the passes below say what
+                pass
         shared = _check_bounds(node, filename)
         if shared is not None:
             try:
@@ -203,6 +227,10 @@ _PLAIN_SCALAR_TAGS = frozenset({_STR_TAG, _INT_TAG, "tag:yaml.org,2002:float",
                                 "tag:yaml.org,2002:bool", "tag:yaml.org,2002:null"})
 
 
+class _NotPlain(Exception):
+    """The document is not one ``_PlainBuilder.checked`` builds."""
+
+
 class _PlainBuilder:
     """What ``loader.construct_document(node)`` builds, for a plain document: only maps,
     sequences, strings, numbers, booleans and nulls, scalar keys, no merge keys (aliases
@@ -225,6 +253,32 @@ class _PlainBuilder:
                 found = self.built[id(node)] = self._build(node)
             return found
         return self._build(node)
+
+    def checked(self, node: yaml.Node, depth: int) -> Any:
+        """``build`` for a document without aliases that also makes ``_check_bounds``'
+        checks on the way; ``_NotPlain`` for anything they or ``build`` would not pass."""
+        if depth > MAX_DEPTH:
+            raise _NotPlain
+        kind = node.__class__
+        tag = node.tag
+        if kind is yaml.ScalarNode:
+            if tag == _STR_TAG:
+                return node.value
+            if tag not in _PLAIN_SCALAR_TAGS or (tag == _INT_TAG
+                                                 and len(node.value) > MAX_INT_TEXT):
+                raise _NotPlain
+            return self.constructors[tag](self.loader, node)
+        depth += 1
+        if kind is yaml.MappingNode and tag == _MAP_TAG:
+            mapping = {}
+            for key, value in node.value:
+                if key.__class__ is not yaml.ScalarNode:
+                    raise _NotPlain
+                mapping[self.checked(key, depth)] = self.checked(value, depth)
+            return mapping
+        if kind is yaml.SequenceNode and tag == _SEQ_TAG:
+            return [self.checked(child, depth) for child in node.value]
+        raise _NotPlain
 
     def _build(self, node: yaml.Node) -> Any:
         tag = node.tag
