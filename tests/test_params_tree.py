@@ -126,6 +126,14 @@ def test_set_notifies_subscribers_of_written_key_and_of_enclosing_namespace(tree
                    ((("/n2", "http://n2/"),), "/a/b/", 7)}
 
 
+def test_a_leaf_write_reaches_the_root_and_enclosing_subscriptions_only(tree):
+    for key, node in [("/", "/root"), ("/a", "/a"), ("/ab", "/ab"), ("/a/b/c", "/below"),
+                      ("/a/bb", "/sibling")]:
+        tree.subscribe(key, node, f"http://{node.strip('/') or 'r'}/")
+    got = {u.subscribers[0][0] for u in tree.set("/a/b", 1)}
+    assert got == {"/root", "/a"}
+
+
 def test_setting_a_dict_notifies_subscribers_inside_it_with_their_own_value(tree):
     tree.subscribe("/a/b/c", "/n", "http://n/")
     tree.subscribe("/a/gone", "/m", "http://m/")

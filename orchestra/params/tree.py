@@ -314,15 +314,26 @@ class ParamTree:
         if not self._subscribers:
             return []
         param_key = subscription_key(key)
-        inner = list(_all_keys(param_key, value)) if isinstance(value, dict) else None
-        inner_set = set(inner) if inner is not None else set()
-        updates: list[ParamUpdate] = []
+        if not isinstance(value, dict):
+            # a leaf reaches only subscriptions at or above it: its own key's prefixes, looked
+            # up one by one (O(depth), not O(subscriptions) per setParam)
+            updates: list[ParamUpdate] = []
+            end = param_key.find(SEP) + 1
+            while end:
+                nodes = self._subscribers.get(param_key[:end])
+                if nodes:
+                    updates.append(ParamUpdate(tuple(nodes), param_key, value))
+                end = param_key.find(SEP, end) + 1
+            return updates
+        inner = list(_all_keys(param_key, value))
+        inner_set = set(inner)
+        updates = []
         for sub, nodes in self._subscribers.items():
             if param_key.startswith(sub):
                 updates.append(ParamUpdate(tuple(nodes), param_key, _copy_dicts(value)))
-            elif inner is not None and sub.startswith(param_key) and sub not in inner_set:
+            elif sub.startswith(param_key) and sub not in inner_set:
                 updates.append(ParamUpdate(tuple(nodes), sub, {}))
-        for sub in inner or ():
+        for sub in inner:
             listeners = self._subscribers.get(sub)
             if listeners:
                 sub_value = value
