@@ -207,7 +207,14 @@ class Interpreter:
     def _req(self, entity: Entity, scope: Scope, *attrs: str) -> list[str]:
         """The resolved values of attributes the table requires (``_check_attrs`` made sure
         they are there)."""
-        return [self._resolve(entity, a, scope) or "" for a in attrs]
+        get = entity.attributes.get
+        out: list[str] = []
+        for a in attrs:
+            value = get(a)
+            # fast path: most attribute values hold no substitution at all
+            out.append(value if value is not None and "$" not in value
+                       else self._resolve(entity, a, scope) or "")
+        return out
 
     def _check_attrs(self, entity: Entity) -> None:
         """The table's attribute rules for ``entity``: unknown attributes are warned about
@@ -625,8 +632,9 @@ class Interpreter:
         delay = self._typed(entity, "respawn_delay", respawn_delay, 0.0) if not is_test else 0.0
         rosmon = self._rosmon_attrs(entity, scope)
 
-        remap_scope = scope.child("")
-        env_scope = scope.child("")
+        # the node's own remaps and <env>s, each in a scope of its own (made when the node
+        # has any: most have none, and then the surrounding scope's are the node's)
+        remap_scope = env_scope = scope
         rule = rules.TAGS["test" if is_test else "node"]
         for sub in entity.children:
             tag = rule.child_tag(sub.tag)
@@ -636,12 +644,16 @@ class Interpreter:
             elif tag == "remap":
                 pair = self._remap_pair(sub, scope)
                 if pair is not None:
+                    if remap_scope is scope:
+                        remap_scope = scope.child("")
                     self._add_remap(sub, remap_scope, pair)
             elif tag == "param":
                 self._param(sub, param_scope, force_local=True)
             elif tag == "rosparam":
                 self._rosparam(sub, param_scope)
             elif tag == "env":
+                if env_scope is scope:
+                    env_scope = scope.child("")
                 self._env(sub, env_scope)
 
         for key, value in [*scope.params.items(), *param_scope.params.items()]:
