@@ -14,11 +14,13 @@ from orchestra.errors import Location
 
 
 class SourcePositions(Protocol):
-    """Where a front end read one element: its start tag and its attribute names."""
+    """Where a front end read an element: its start tag and its attribute names. One object
+    may serve every element of a file (asked with the element), so reading a file does not
+    make one per element."""
 
-    def start(self) -> Location: ...
+    def start(self, entity: Entity) -> Location: ...
 
-    def attribute(self, name: str) -> Location | None: ...
+    def attribute(self, entity: Entity, name: str) -> Location | None: ...
 
 
 @dataclass(frozen=True)
@@ -28,10 +30,10 @@ class KnownPositions:
     start_at: Location
     attributes: Mapping[str, Location]
 
-    def start(self) -> Location:
+    def start(self, entity: Entity) -> Location:
         return self.start_at
 
-    def attribute(self, name: str) -> Location | None:
+    def attribute(self, entity: Entity, name: str) -> Location | None:
         return self.attributes.get(name)
 
 
@@ -66,15 +68,15 @@ class Entity:
         if self.positions is None:
             return self.location
         if attribute is not None and attribute in self.attributes:
-            found = self.positions.attribute(attribute)
+            found = self.positions.attribute(self, attribute)
             if found is not None:
                 return found
-        return self.positions.start()
+        return self.positions.start(self)
 
     @property
     def attribute_locations(self) -> dict[str, Location]:
         """Exact positions of the attributes the front end located."""
         if self.positions is None:
             return {}
-        found = {name: self.positions.attribute(name) for name in self.attributes}
+        found = {name: self.positions.attribute(self, name) for name in self.attributes}
         return {name: where for name, where in found.items() if where is not None}

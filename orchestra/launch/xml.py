@@ -54,35 +54,53 @@ _ATTRIBUTE = re.compile(r"\s+([^\s=/>]+)\s*=\s*(?:\"[^\"]*\"|'[^']*')")
 
 
 class _Document:
-    """The text of one document and, once a position is asked for (an error, ``orchestra
-    check``), the offset of each start tag in document order and the line starts: most
-    elements of most files are never asked, so a load never scans the text."""
+    """``SourcePositions`` of every element of one document: the text and, once a position
+    is asked for (an error, ``orchestra check``), the offset of each start tag in document
+    order and the line starts. Most elements of most files are never asked, so a load
+    neither scans the text nor keeps an object per element: only each element's index."""
 
     def __init__(self, data: bytes, filename: str, elements: int):
         self.data = data
         self.filename = filename
         self.elements = elements  # element count lxml saw: the scan must find as many
+        self.index_of: dict[int, int] = {}  # id(entity) -> its index in document order
         self._text: str | None = None
         self._tags: list[int] | None = None
         self._line_starts: list[int] | None = None
 
-    def tags(self) -> list[int] | None:
-        """Start tag offsets in document order; None when the scan does not see the
-        elements lxml saw (an encoding or construct it does not follow: lines only)."""
+    def start(self, entity: Entity) -> Location:
+        offset = self._offset(entity)
+        return entity.location if offset is None else self._location(offset)
+
+    def attribute(self, entity: Entity, name: str) -> Location | None:
+        tag_offset = self._offset(entity)
+        if tag_offset is None:
+            return None
+        offset = self._attribute_offset(tag_offset, name)
+        return self._location(offset) if offset is not None else None
+
+    def _offset(self, entity: Entity) -> int | None:
+        """Where ``entity``'s start tag is; None when the scan does not see the elements
+        lxml saw (an encoding or construct it does not follow: lxml's line stands)."""
+        index = self.index_of.get(id(entity))
+        tags = self._scan()
+        return tags[index] if index is not None and tags is not None else None
+
+    def _scan(self) -> list[int] | None:
         if self._tags is None:
             self._text = _decode(self.data)
             self._tags = [m.start() for m in _MARKUP.finditer(self._text)
                           if m.group(1) is not None]
         return self._tags if len(self._tags) == self.elements else None
 
-    def location(self, offset: int) -> Location:
-        assert self._text is not None  # offsets come from tags()
+    def _location(self, offset: int) -> Location:
+        assert self._text is not None  # offsets come from _scan()
         if self._line_starts is None:
             self._line_starts = [0] + [m.end() for m in re.finditer("\n", self._text)]
         row = bisect.bisect_right(self._line_starts, offset) - 1
         return Location(self.filename, row + 1, offset - self._line_starts[row] + 1)
 
-    def attribute_offset(self, tag_offset: int, name: str) -> int | None:
+    def _attribute_offset(self, tag_offset: int, name: str) -> int | None:
         assert self._text is not None
         match = _TAG_NAME.match(self._text, tag_offset)
         pos = match.end() if match else tag_offset
@@ -93,33 +111,6 @@ class _Document:
             if attr.group(1) == name:
                 return attr.start(1)
             pos = attr.end()
-
-
-class _ElementPositions:
-    """``SourcePositions`` of the ``index``-th element of a document; ``line`` (lxml's
-    location of it) stands in when the document's scan cannot place it."""
-
-    __slots__ = ("_document", "_index", "_line")
-
-    def __init__(self, document: _Document, index: int, line: Location):
-        self._document = document
-        self._index = index
-        self._line = line
-
-    def _offset(self) -> int | None:
-        tags = self._document.tags()
-        return tags[self._index] if tags is not None else None
-
-    def start(self) -> Location:
-        offset = self._offset()
-        return self._line if offset is None else self._document.location(offset)
-
-    def attribute(self, name: str) -> Location | None:
-        tag_offset = self._offset()
-        if tag_offset is None:
-            return None
-        offset = self._document.attribute_offset(tag_offset, name)
-        return self._document.location(offset) if offset is not None else None
 
 
 def _decode(data: bytes) -> str:
@@ -151,6 +142,7 @@ def _entities(start: etree._Element, filename: str, document: _Document | None,
     document, resolved by ``_Document`` when asked for."""
     count = first_index   # the index of the next element
     launches = 0
+    index_of = document.index_of if document is not None else None
 
     def entity(element: etree._Element) -> Entity:
         nonlocal count, launches
@@ -180,9 +172,11 @@ def _entities(start: etree._Element, filename: str, document: _Document | None,
                 if name[0] == "{":
                     attributes = {_qualified(element, k): v for k, v in attributes.items()}
                     break
-        location = Location(filename, element.sourceline)
-        positions = None if document is None else _ElementPositions(document, index, location)
-        return Entity(tag, attributes, children, text or None, location, positions)
+        made = Entity(tag, attributes, children, text or None,
+                      Location(filename, element.sourceline), document)
+        if index_of is not None:
+            index_of[id(made)] = index
+        return made
 
     root = entity(start)
     return root, count - first_index, launches
