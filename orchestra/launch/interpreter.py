@@ -439,7 +439,10 @@ class Interpreter:
         name = attributes["name"].strip()
         if "$" in name:
             name = self._resolve(entity, "name", scope, name) or ""
-        value = self._param_value(entity, name, ptype, source, raw)
+        if source == "value":
+            value = self._convert(entity, raw.strip(), ptype, source)
+        else:
+            value = self._param_value(entity, name, ptype, source, raw)
         if is_private(name) or force_local:
             scope.add_param(name, value)
         else:
@@ -448,8 +451,7 @@ class Interpreter:
 
     def _param_value(self, entity: Entity, name: str, ptype: str, source: str, raw: str
                      ) -> Any:
-        if source == "value":
-            return self._convert(entity, raw.strip(), ptype, source)
+        """The value of a <param> whose ``source`` is not ``value`` (a file or a command)."""
         if source == "textfile":
             try:
                 text = read_text(raw)
@@ -656,10 +658,10 @@ class Interpreter:
                     env_scope = scope.child("")
                 self._env(sub, env_scope)
 
-        for key, value in [*scope.params.items(), *param_scope.params.items()]:
-            if is_private(key):
-                key = key[1:]
-            self._set_param(param_scope.ns + key, value)
+        node_ns, set_param = param_scope.ns, self._set_param
+        for params in (scope.params, param_scope.params):
+            for key, value in params.items():
+                set_param(node_ns + (key[1:] if is_private(key) else key), value)
 
         if respawn_flag and required_flag:
             raise self._error(entity, "respawn and required cannot both be true")
