@@ -22,9 +22,11 @@ class LaunchSyntaxError(OrchestraError):
 
 
 def _parser() -> etree.XMLParser:
+    # comments are dropped while parsing (libxml2 joins the text around one, which is the
+    # element text this front end gives); ``orchestra convert`` reads them with its own
     return etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False,
                            dtd_validation=False, huge_tree=False, remove_pis=True,
-                           remove_comments=False)
+                           remove_comments=True)
 
 
 def _qualified(element: etree._Element, name: str) -> str:
