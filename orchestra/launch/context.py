@@ -70,11 +70,10 @@ class Scope:
         if child_ns.startswith(PRIVATE):
             raise ScopeError(f"namespace [{child_ns}] is private: a namespace must be "
                              "relative or global")
-        return Scope(child_ns, self.filename, parent=self, params=self.params,
-                     env_args=list(self.env_args), args=dict(self.args),
-                     arg_names=list(self.arg_names),
-                     include_args=self.include_args, pass_all_args=self.pass_all_args,
-                     include_stack=self.include_stack)
+        # positional: a node or group makes several of these, and keyword calls cost more
+        return Scope(child_ns, self.filename, self, self.params, list(self.env_args),
+                     dict(self.args), list(self.arg_names), self.include_args,
+                     self.pass_all_args, self.include_stack)
 
     def include_child(self, ns: str | None, filename: str) -> Scope:
         """The scope an ``<include>`` tag's own ``<arg>``/``<env>`` children are read in."""

@@ -236,7 +236,7 @@ class Interpreter:
             if attr in present:
                 raise self._error(entity, f"<{entity.tag}> cannot have this attribute", attr,
                                   rules.FORBIDDEN_ATTRIBUTE)
-        if not rule.children:
+        if entity.children and not rule.children:
             for child in entity.children:
                 if not (entity.tag == "machine" and child.tag == "env"):  # an error, below
                     self._warn(child, f"unrecognized <{child.tag}> tag in <{entity.tag}>",
