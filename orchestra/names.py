@@ -31,9 +31,10 @@ def is_private(name: str) -> bool:
 
 def make_global_ns(name: str) -> str:
     """``name`` as a global namespace with a trailing slash (``a/b`` -> ``/a/b/``)."""
-    if is_private(name):
+    first = name[:1]  # is_private / is_global, written out: every scope and node asks
+    if first == PRIVATE:
         raise ValueError(f"cannot turn [{name}] into a global name")
-    if not is_global(name):
+    if first != SEP:
         name = SEP + name
     if name[-1] != SEP:
         name += SEP
@@ -42,7 +43,8 @@ def make_global_ns(name: str) -> str:
 
 def ns_join(ns: str, name: str) -> str:
     """Join a namespace and a name; global and private names are left alone."""
-    if is_private(name) or is_global(name):
+    first = name[:1]  # is_private / is_global, written out: every param and key asks
+    if first == PRIVATE or first == SEP:
         return name
     if ns == PRIVATE:
         return PRIVATE + name
