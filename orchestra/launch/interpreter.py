@@ -41,6 +41,7 @@ __all__ = ["ArgInfo", "Binary", "Interpreter", "LaunchError", "LoadOptions", "bi
 
 # where a <param>'s value comes from: exactly one is written
 _PARAM_SOURCES = ("value", "textfile", "binfile", "command")
+_PARAM_SOURCE_SET = frozenset(_PARAM_SOURCES)
 
 # Files deep an include chain may go (real trees are a handful deep; a chain of distinct files
 # has no cycle to stop it).
@@ -427,12 +428,13 @@ class Interpreter:
         self._check_attrs(entity)
         attributes = entity.attributes
         ptype = self._typed(entity, "type", attributes.get("type") or "")
-        given = [s for s in _PARAM_SOURCES if s in attributes]
-        if len(given) != 1:
+        found = _PARAM_SOURCE_SET.intersection(attributes)
+        if len(found) != 1:
             self._opt(entity, scope, *_PARAM_SOURCES)  # a bad substitution is named first
+            given = [s for s in _PARAM_SOURCES if s in found]
             raise self._error(entity, "<param> must have exactly one of value/textfile/"
                               f"binfile/command (has {', '.join(given) or 'none'})")
-        source = given[0]
+        (source,) = found
         raw = attributes[source]
         if "$" in raw:
             raw = self._resolve(entity, source, scope) or ""
