@@ -157,17 +157,18 @@ def _entities(start: etree._Element, filename: str, document: _Document | None,
             tag = _qualified(element, tag)
         children = []
         text = element.text
-        pieces = None
-        for child in element:
-            if child.tag.__class__ is str:
-                children.append(entity(child))
-            tail = child.tail
-            if tail:
-                if pieces is None:
-                    pieces = [text] if text else []
-                pieces.append(tail)
-        if pieces is not None:
-            text = "".join(pieces)
+        if len(element):  # most elements are leaves: no iterator for them
+            pieces = None
+            for child in element:
+                if child.tag.__class__ is str:
+                    children.append(entity(child))
+                tail = child.tail
+                if tail:
+                    if pieces is None:
+                        pieces = [text] if text else []
+                    pieces.append(tail)
+            if pieces is not None:
+                text = "".join(pieces)
         attributes = dict(element.items())
         if prefixes:
             for name in attributes:
