@@ -6,8 +6,8 @@ same machine: plain Python processes exchanging the same bytes over a loopback T
 with no ROS layer at all. Ratios (orchestra / baseline) are what to compare between
 machines; absolute numbers depend on the CPU and on what else runs.
 
-    python bench/bench_node.py            # full run (~1 minute)
-    python bench/bench_node.py --quick    # fewer samples
+    python bench/bench_node.py            # full run (~5 minutes)
+    python bench/bench_node.py --quick    # fewer samples (~2 minutes)
 
 Processes: an in-process master, then a publisher process and a subscriber process (or a
 service and a client process). One-way latency = receive time - send time, both read from
@@ -146,7 +146,8 @@ def role_sub(kind: str, count: int, burst: int) -> None:
     rospy.Subscriber("/bench", type(msg), callback, queue_size=burst or 10)
     emit({"ready": True})
     line = sys.stdin.readline()  # "latency done" from the parent
-    emit({"latency": summarize(latencies)})
+    # every sample too when there is no burst (the 100 Hz runs: their rounds are pooled)
+    emit({"latency": summarize(latencies), **({} if burst else {"samples": latencies})})
     if not burst:
         rospy.signal_shutdown("done")
         return
@@ -345,12 +346,13 @@ def bench_topic(env: dict, kind: str, count: int, burst: int, gap: float,
                 "--gap", str(gap), impl=pub_impl)
     read(pub, "latency_sent")
     tell(sub, "latency done 20")
-    latency = read(sub, "latency")["latency"]
+    got = read(sub, "latency")
+    latency = got["latency"]
     tell(pub)
     if not burst:
         for proc in (pub, sub):
             proc.wait(15)
-        return {"latency": latency}
+        return {"latency": latency, "samples": got["samples"]}
     read(pub, "burst_sent")
     throughput = read(sub, "throughput")["throughput"]
     tell(pub)
@@ -419,13 +421,17 @@ def main() -> None:
                     results["ros1"][f"{kind} {pub_impl}->{sub_impl}"] = bench_topic(
                         env, kind, count, burst, gap, pub_impl, sub_impl)
             # Twist at 100 Hz (a robot's cmd_vel): latency only, every pair in each of
-            # ROUNDS interleaved rounds, medians of the rounds' medians and p99s
+            # ROUNDS interleaved rounds; the rounds' samples pooled per pair (a p99 of one
+            # 6 s round is its 6th-worst message: one scheduler hiccup moves it by ms)
             slow = int(SLOW_TWIST_COUNT * scale)
+            pooled: dict[str, list[float]] = {}
             for _ in range(ROUNDS):
                 for pub_impl, sub_impl in PAIRS:
                     got = bench_topic(env, "twist", slow, 0, 0.01, pub_impl, sub_impl)
-                    results["ros1"].setdefault(f"twist100 {pub_impl}->{sub_impl}", []).append(
-                        got["latency"])
+                    pooled.setdefault(f"twist100 {pub_impl}->{sub_impl}", []).extend(
+                        got["samples"])
+            for key, samples in pooled.items():
+                results["ros1"][key] = summarize(samples)
             # service pairs interleaved over ROUNDS rounds, medians kept (the shared
             # machine's load swings single runs by 2x); orchestra->orchestra included
             for _ in range(ROUNDS):
@@ -530,10 +536,10 @@ def print_ros1(results: dict, plan: dict) -> None:
             print(line)
     slow = [results["ros1"][f"twist100 {a}->{b}"] for a, b in PAIRS]
     for key, name in (("median_us", "latency median (us)"), ("p99_us", "latency p99 (us)")):
-        values = [median_of(runs, key) for runs in slow]
+        values = [r[key] for r in slow]
         print(f"{'Twist 100 Hz ' + name:36.36}" + "".join(f"{v:14.0f}" for v in values)
               + f"{values[1] / values[0]:11.1f}x")
-    p99 = [median_of(runs, "p99_us") for runs in slow]
+    p99 = [r["p99_us"] for r in slow]
     print(f"{'  p99 mixed pairs vs rospy->rospy':36.36}{'':28}{p99[1] / p99[2]:14.1f}x"
           f"{p99[1] / p99[3]:13.1f}x   (>= 1.0x: no worse than rospy)")
     svc = [results["ros1"][f"service {a}->{b}"] for a, b in PAIRS]
@@ -541,7 +547,8 @@ def print_ros1(results: dict, plan: dict) -> None:
         values = [median_of(runs, key) for runs in svc]
         print(f"{'service calls/s ' + key + ', median':36.36}"
               + "".join(f"{v:14.0f}" for v in values) + f"{values[0] / values[1]:11.1f}x")
-    print(f"(100 Hz and service rows: medians of {ROUNDS} interleaved rounds)")
+    print(f"(100 Hz rows: {ROUNDS} interleaved rounds pooled, {slow[0]['n']} messages per "
+          f"pair; service rows: medians of {ROUNDS} interleaved rounds)")
     print("rospy/orch = how many times orchestra->orchestra beats rospy->rospy (higher: "
           "orchestra better)")
 
