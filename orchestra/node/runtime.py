@@ -124,18 +124,17 @@ class TcprosServer:
             if "service" in header:
                 server = self.rt.services.get(header["service"])
                 if server is None:
-                    from orchestra.node.topics import _refuse
-                    _refuse(conn, f"no service [{header['service']}] provided by {self.rt.name}",
-                            f"{header.get('callerid')} asked for unknown service "
-                            f"{header['service']}")
+                    log.warning("%s asked for unknown service %s", header.get("callerid"),
+                                header["service"])
+                    tcpros.refuse(conn, f"no service [{header['service']}] provided by "
+                                        f"{self.rt.name}")
                     return
                 server.handle(conn, reader, header)
             elif "topic" in header:
                 self.rt.topics.handle_subscriber(conn, header)
             else:
-                from orchestra.node.topics import _refuse
-                _refuse(conn, "no topic or service name detected",
-                        f"connection from {addr} named neither a topic nor a service")
+                log.warning("connection from %s named neither a topic nor a service", addr)
+                tcpros.refuse(conn, "no topic or service name detected")
         except OSError as exc:
             log.debug("TCPROS connection from %s failed: %s", addr, exc)
             conn.close()

@@ -81,8 +81,6 @@ class ServiceServer:
     def handle(self, sock: socket.socket, reader: tcpros.Reader, header: dict[str, str]) -> None:
         """Serve one client connection (runs on the connection's own thread); ``reader``
         holds whatever the client sent after its header."""
-        from orchestra.node.topics import _refuse
-
         caller = header.get("callerid", "?")
         cls = self.srv_class
         if header.get("probe") == "1":
@@ -93,10 +91,10 @@ class ServiceServer:
             return
         their = header.get("md5sum", "")
         if their not in ("*", cls._md5sum):
-            _refuse(sock, f"request from [{caller}]: md5sums do not match: [{their}] vs. "
-                          f"[{cls._md5sum}]",
-                    f"refused call of {self.name} by {caller}: it expects md5 {their}, "
-                    f"the service is {cls._type} ({cls._md5sum})")
+            log.warning("refused call of %s by %s: it expects md5 %s, the service is %s (%s)",
+                        self.name, caller, their, cls._type, cls._md5sum)
+            tcpros.refuse(sock, f"request from [{caller}]: md5sums do not match: [{their}] vs. "
+                                f"[{cls._md5sum}]")
             return
         persistent = header.get("persistent") == "1"
         with self.lock:

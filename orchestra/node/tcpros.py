@@ -116,6 +116,17 @@ def write_header(sock: socket.socket, fields: dict[str, str]) -> None:
     sock.sendall(encode_header(fields))
 
 
+def refuse(sock: socket.socket, error: str) -> None:
+    """Answer a connection with an ``error`` header and close it (the peer may be gone
+    already: nothing to tell it then)."""
+    try:
+        write_header(sock, {"error": error})
+    except OSError:
+        pass
+    finally:
+        sock.close()
+
+
 def read_message(sock: socket.socket) -> bytes:
     return ExactReader(sock).message()
 

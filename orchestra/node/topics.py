@@ -705,17 +705,17 @@ class TopicManager:
             pub = self.publications.get(topic)
         caller = header.get("callerid", "?")
         if pub is None:
-            _refuse(sock, f"no topic [{topic}] published by {self.rt.name}",
-                    f"{caller} asked for {topic}, which this node does not publish")
+            log.warning("%s asked for %s, which this node does not publish", caller, topic)
+            tcpros.refuse(sock, f"no topic [{topic}] published by {self.rt.name}")
             return
         their_md5 = header.get("md5sum", "")
         cls = pub.msg_class
         if not md5_compatible(their_md5, cls._md5sum):
-            _refuse(sock, f"Client [{caller}] wants topic {topic} to have datatype/md5sum "
-                          f"[{header.get('type')}/{their_md5}], but our version has "
-                          f"[{cls._type}/{cls._md5sum}]. Dropping connection.",
-                    f"refused subscriber {caller} on {topic}: it expects "
-                    f"{header.get('type')} ({their_md5}), we publish {cls._type} ({cls._md5sum})")
+            log.warning("refused subscriber %s on %s: it expects %s (%s), we publish %s (%s)",
+                        caller, topic, header.get("type"), their_md5, cls._type, cls._md5sum)
+            tcpros.refuse(sock, f"Client [{caller}] wants topic {topic} to have datatype/md5sum "
+                                f"[{header.get('type')}/{their_md5}], but our version has "
+                                f"[{cls._type}/{cls._md5sum}]. Dropping connection.")
             return
         tcpros.write_header(sock, {
             "callerid": self.rt.name, "topic": topic, "md5sum": cls._md5sum, "type": cls._type,
@@ -785,15 +785,4 @@ def xmlrpc_int(n: int) -> int | float:
     """XML-RPC integers are 32-bit: byte counters of a camera stream pass 2**31 within
     seconds, so larger counts travel as doubles instead of failing the whole call."""
     return n if -2**31 <= n < 2**31 else float(n)
-
-
-def _refuse(sock: socket.socket, error: str, reason: str) -> None:
-    """Answer a connection with an ``error`` header, log why, and close it."""
-    log.warning("%s", reason)
-    try:
-        tcpros.write_header(sock, {"error": error})
-    except OSError:
-        pass
-    finally:
-        sock.close()
 
