@@ -94,16 +94,20 @@ class OutConnection:
         """Send ``data`` without blocking (caller holds ``cond``); False when nothing was
         sent (the writer takes the message); a part sent leaves the rest to the writer."""
         buffers = tcpros.frame(data)
+        total = 4 + len(data)
+        # counted before it goes: a subscriber that has it must never find the publisher's
+        # bus stats without it
+        self.bytes_sent += total
+        self.messages_sent += 1
         try:
             sent = self.sock.sendmsg(buffers, (), socket.MSG_DONTWAIT)
-        except OSError:  # full (EAGAIN) or broken: the writer sends it or finds out
+        except OSError:  # full (EAGAIN) or broken: the writer sends it (and counts it)
+            self.bytes_sent -= total
+            self.messages_sent -= 1
             return False
-        total = 4 + len(data)
         if sent < total:
             self.rest = b"".join(bytes(b) for b in buffers)[sent:]
             self.cond.notify()
-        self.bytes_sent += total
-        self.messages_sent += 1
         return True
 
     def idle(self) -> bool:
@@ -122,6 +126,10 @@ class OutConnection:
                 rest, self.rest = self.rest, None
                 data = self.queue.popleft() if rest is None else None
                 self.writing = True
+                if data is not None:   # counted before it goes, as in _send_now (a
+                    # failed send ends the connection)
+                    self.bytes_sent += len(data) + 4
+                    self.messages_sent += 1
             try:
                 if data is not None:
                     tcpros.send_message(sock, data)
@@ -134,9 +142,6 @@ class OutConnection:
                 return
             with self.cond:
                 self.writing = False
-                if data is not None:
-                    self.bytes_sent += len(data) + 4
-                    self.messages_sent += 1
 
     def peer_closed(self) -> bool:
         """Whether the subscriber hung up. Subscribers send nothing after their header, so a
