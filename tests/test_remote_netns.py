@@ -12,6 +12,7 @@ import os
 import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -134,6 +135,17 @@ def leftovers(bed) -> list[int]:
             if pid != bed.sshd.pid]
 
 
+def assert_nothing_left(bed, within: float = 5.0) -> None:
+    """After a run has ended: nothing of it left in either namespace. The remote agent ends
+    on sshd's SIGHUP a moment after the launch's ssh client has gone (the launch does not
+    wait for that), so this waits briefly; it failed often once the launch's own exit got
+    faster (gc.freeze)."""
+    deadline = time.monotonic() + within
+    while leftovers(bed) and time.monotonic() < deadline:
+        time.sleep(0.02)
+    assert [cmdline(pid) for pid in leftovers(bed)] == []
+
+
 def cmdline(pid: int) -> bytes:
     try:
         return Path(f"/proc/{pid}/cmdline").read_bytes()
@@ -177,7 +189,7 @@ def test_remote_nodes_run_remotely_respawn_and_a_required_death_stops_both_sides
     assert "[/talker] hello from talker" in text                     # remote output, prefixed
     assert "[/arm/boss] boss dying" in text
     assert "process[/crashy]: died (exit code 3), respawning" in text
-    assert leftovers(bed) == []
+    assert_nothing_left(bed)
 
 
 def test_remote_argv_env_are_roslaunchs_and_sigint_stops_both_sides(bed, run):
@@ -193,7 +205,7 @@ def test_remote_argv_env_are_roslaunchs_and_sigint_stops_both_sides(bed, run):
     proc.send_signal(signal.SIGINT)
     output, _ = proc.communicate(timeout=30)
     assert proc.returncode == 0, output.decode(errors="replace")
-    assert leftovers(bed) == []
+    assert_nothing_left(bed)
     talker, boss = found["talker"][0], found["boss"][0]
     exe = str(bed.workspace / "rdemo" / "probe")
     # roslaunch's remote child: create_local_process_args + setup_env on the remote side,
