@@ -9,13 +9,12 @@ import time
 import xmlrpc.client
 from pathlib import Path
 
-import psutil
 import pytest
 
 from orchestra.master import master_is_up
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
-from harness import free_port  # noqa: E402
+from harness import cpu_seconds, free_port  # noqa: E402
 
 pytestmark = pytest.mark.timeout(60)
 
@@ -98,7 +97,7 @@ def test_ctrl_c_in_cores_first_moments_stops_it_and_its_master(moment):
                                 text=True, env=env)
         # (an idle core stops using CPU: a moment past its start-up is never reached)
         deadline = time.monotonic() + 10.0
-        while (_cpu_seconds(proc.pid) < moment and proc.poll() is None
+        while (cpu_seconds(proc.pid) < moment and proc.poll() is None
                and time.monotonic() < deadline):
             time.sleep(0.005)
         proc.send_signal(signal.SIGINT)
@@ -107,11 +106,3 @@ def test_ctrl_c_in_cores_first_moments_stops_it_and_its_master(moment):
         assert proc.returncode in (-signal.SIGINT, 130, 0), err
         assert "Traceback" not in err and "Exception ignored" not in err, err
         assert not master_is_up(f"http://127.0.0.1:{port}/", timeout=0.5)
-
-
-def _cpu_seconds(pid: int) -> float:
-    try:
-        times = psutil.Process(pid).cpu_times()
-    except psutil.NoSuchProcess:
-        return float("inf")
-    return times.user + times.system

@@ -15,7 +15,7 @@ import pytest
 pytestmark = pytest.mark.timeout(90)
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
-from harness import demo_package, free_port  # noqa: E402
+from harness import cpu_seconds, demo_package, free_port  # noqa: E402
 
 NODE = """#!/bin/sh
 # a node that forks a helper (same process group), records both pids, and waits
@@ -260,14 +260,6 @@ def test_output_both_writes_the_console_and_the_log_file(launch_env):
     assert "[/t] both-line" in out
 
 
-def _cpu_seconds(pid: int) -> float:
-    try:
-        times = psutil.Process(pid).cpu_times()
-    except psutil.NoSuchProcess:
-        return float("inf")
-    return times.user + times.system
-
-
 @pytest.mark.parametrize("moment", [0.0, 0.03, 0.06, 0.09, 0.12])
 def test_ctrl_c_in_the_launchs_first_moments_always_ends_it(launch_env, moment):
     """Found sending Ctrl-C within 0.2 s of start: ~2 in 30 launches ran on, the
@@ -276,7 +268,7 @@ def test_ctrl_c_in_the_launchs_first_moments_always_ends_it(launch_env, moment):
     starting), three times each."""
     for _ in range(3):
         with running(launch_env) as proc:
-            while _cpu_seconds(proc.pid) < moment and proc.poll() is None:
+            while cpu_seconds(proc.pid) < moment and proc.poll() is None:
                 time.sleep(0.005)
             proc.send_signal(signal.SIGINT)
             out, err = proc.communicate(timeout=30)

@@ -18,6 +18,8 @@ import time
 import xmlrpc.client
 from pathlib import Path
 
+import psutil
+
 HERE = Path(__file__).resolve().parent
 
 ADD_TWO_INTS = "int64 a\nint64 b\n---\nint64 sum\n"
@@ -43,6 +45,16 @@ def free_port() -> int:
     with socket.socket() as sock:
         sock.bind(("127.0.0.1", 0))
         return sock.getsockname()[1]
+
+
+def cpu_seconds(pid: int) -> float:
+    """CPU time (user + system) a process has used so far; infinite once it is gone (for
+    tests that act at a moment of a process's start-up)."""
+    try:
+        times = psutil.Process(pid).cpu_times()
+    except psutil.NoSuchProcess:
+        return float("inf")
+    return times.user + times.system
 
 
 def demo_package(ws: Path, nodes: dict[str, str], name: str = "demo") -> Path:
