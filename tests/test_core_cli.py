@@ -5,7 +5,6 @@ import os
 import signal
 import subprocess
 import sys
-import time
 import xmlrpc.client
 from pathlib import Path
 
@@ -14,7 +13,7 @@ import pytest
 from orchestra.master import master_is_up
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
-from harness import cpu_seconds, free_port  # noqa: E402
+from harness import free_port, wait_for_cpu  # noqa: E402
 
 pytestmark = pytest.mark.timeout(60)
 
@@ -95,11 +94,7 @@ def test_ctrl_c_in_cores_first_moments_stops_it_and_its_master(moment):
         proc = subprocess.Popen([sys.executable, "-m", "orchestra", "core", "-p", str(port),
                                  "--no-rosout"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                 text=True, env=env)
-        # (an idle core stops using CPU: a moment past its start-up is never reached)
-        deadline = time.monotonic() + 10.0
-        while (cpu_seconds(proc.pid) < moment and proc.poll() is None
-               and time.monotonic() < deadline):
-            time.sleep(0.005)
+        wait_for_cpu(proc, moment)
         proc.send_signal(signal.SIGINT)
         out, err = proc.communicate(timeout=30)
         # -SIGINT: before Python's own handler existed; 130: during the imports; 0: stopped

@@ -15,7 +15,7 @@ import pytest
 pytestmark = pytest.mark.timeout(90)
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
-from harness import cpu_seconds, demo_package, free_port  # noqa: E402
+from harness import demo_package, free_port, wait_for_cpu  # noqa: E402
 
 NODE = """#!/bin/sh
 # a node that forks a helper (same process group), records both pids, and waits
@@ -268,8 +268,7 @@ def test_ctrl_c_in_the_launchs_first_moments_always_ends_it(launch_env, moment):
     starting), three times each."""
     for _ in range(3):
         with running(launch_env) as proc:
-            while cpu_seconds(proc.pid) < moment and proc.poll() is None:
-                time.sleep(0.005)
+            wait_for_cpu(proc, moment)
             proc.send_signal(signal.SIGINT)
             out, err = proc.communicate(timeout=30)
         # -SIGINT: before Python's own handler existed; 130: during the imports; 0: stopped

@@ -48,13 +48,22 @@ def free_port() -> int:
 
 
 def cpu_seconds(pid: int) -> float:
-    """CPU time (user + system) a process has used so far; infinite once it is gone (for
-    tests that act at a moment of a process's start-up)."""
+    """CPU time (user + system) a process has used so far; infinite once it is gone."""
     try:
         times = psutil.Process(pid).cpu_times()
     except psutil.NoSuchProcess:
         return float("inf")
     return times.user + times.system
+
+
+def wait_for_cpu(proc: subprocess.Popen, seconds: float, within: float = 10.0) -> None:
+    """Return once ``proc`` has used ``seconds`` of CPU (a moment of its start-up, whatever
+    the machine's load), has ended, or ``within`` s have passed: a process that goes idle
+    sooner never reaches a later moment."""
+    deadline = time.monotonic() + within
+    while (cpu_seconds(proc.pid) < seconds and proc.poll() is None
+           and time.monotonic() < deadline):
+        time.sleep(0.005)
 
 
 def demo_package(ws: Path, nodes: dict[str, str], name: str = "demo") -> Path:
