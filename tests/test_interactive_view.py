@@ -16,7 +16,7 @@ import pytest
 from orchestra.supervise.interactive import parse_keys
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
-from harness import free_port, wait_for  # noqa: E402
+from harness import demo_package, free_port, wait_for  # noqa: E402
 
 pytestmark = pytest.mark.timeout(90)
 
@@ -54,16 +54,9 @@ class Pane:
 
 @pytest.mark.skipif(shutil.which("tmux") is None, reason="tmux is not installed")
 def test_interactive_view_select_restart_mute_filter_quit(tmp_path):
-    pkg = tmp_path / "ws" / "demo"
-    (pkg / "nodes").mkdir(parents=True)
-    (pkg / "package.xml").write_text(
-        "<package format='2'><name>demo</name><version>0.0.0</version><description>d"
-        "</description><maintainer email='a@b.c'>a</maintainer><license>BSD</license></package>")
-    (pkg / "nodes" / "sleeper").write_text("#!/bin/sh\nexec sleep 1000\n")
-    (pkg / "nodes" / "talker").write_text(
-        "#!/bin/sh\ni=0\nwhile true; do i=$((i+1)); echo \"tick $i\"; sleep 0.2; done\n")
-    for node in ("sleeper", "talker"):
-        (pkg / "nodes" / node).chmod(0o755)
+    pkg = demo_package(tmp_path / "ws", {
+        "sleeper": "#!/bin/sh\nexec sleep 1000\n",
+        "talker": "#!/bin/sh\ni=0\nwhile true; do i=$((i+1)); echo \"tick $i\"; sleep 0.2; done\n"})
     (tmp_path / "ui.launch").write_text(LAUNCH)
     env = {"PYTHONPATH": os.environ.get("PYTHONPATH", ""), "ROS_PACKAGE_PATH": str(pkg.parent),
            "ROS_MASTER_URI": f"http://localhost:{free_port()}/",

@@ -16,7 +16,7 @@ from orchestra.app.cli import log_size_warning
 from orchestra.launch.summary import summary_value
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
-from harness import ROS_PYTHON, free_port, wait_for  # noqa: E402
+from harness import ROS_PYTHON, demo_package, free_port, wait_for  # noqa: E402
 
 pytestmark = pytest.mark.timeout(90)
 REPO = Path(__file__).resolve().parent.parent
@@ -31,19 +31,20 @@ LAUNCH = """<launch>
 
 @pytest.fixture
 def env(tmp_path):
-    pkg = tmp_path / "ws" / "demo"
-    (pkg / "nodes").mkdir(parents=True)
-    (pkg / "package.xml").write_text(
-        "<package format='2'><name>demo</name><version>0.0.0</version><description>d"
-        "</description><maintainer email='a@b.c'>a</maintainer><license>BSD</license></package>")
-    (pkg / "nodes" / "sleeper").write_text("#!/bin/sh\nexec sleep 1000\n")
-    (pkg / "nodes" / "sleeper").chmod(0o755)
+    demo_package(tmp_path / "ws", {"sleeper": "#!/bin/sh\nexec sleep 1000\n"})
     (tmp_path / "x.launch").write_text(LAUNCH)
     environ = {k: v for k, v in os.environ.items() if k not in ("ROS_LOG_DIR", "ROS_NAMESPACE")}
     environ.update(ROS_PACKAGE_PATH=str(tmp_path / "ws"), ROS_HOME=str(tmp_path / "home"),
                    ROS_MASTER_URI=f"http://localhost:{free_port()}/",
                    XDG_RUNTIME_DIR=str(tmp_path))
     return environ
+
+
+def add_node(tmp_path, name: str, script: str) -> None:
+    """One more executable in the env fixture's demo package."""
+    path = tmp_path / "ws" / "demo" / "nodes" / name
+    path.write_text(script)
+    path.chmod(0o755)
 
 
 def start(env, *args: str) -> subprocess.Popen:
@@ -207,8 +208,7 @@ def test_summary_equals_real_roslaunchs_for_the_turtle_tf_demo(tmp_path):
 
 
 def test_undeclared_command_line_arg_is_warned_with_a_suggestion(env, tmp_path):
-    (tmp_path / "ws" / "demo" / "nodes" / "done").write_text("#!/bin/sh\nexit 0\n")
-    (tmp_path / "ws" / "demo" / "nodes" / "done").chmod(0o755)
+    add_node(tmp_path, "done", "#!/bin/sh\nexit 0\n")
     (tmp_path / "args.launch").write_text(
         '<launch><arg name="driver" default="teleop"/><group><arg name="speed" default="1"/>'
         '</group><node pkg="demo" type="done" name="job" required="true"/></launch>')
@@ -222,8 +222,7 @@ def test_undeclared_command_line_arg_is_warned_with_a_suggestion(env, tmp_path):
 
 
 def test_ui_without_a_terminal_falls_back_to_plain_output(env, tmp_path):
-    (tmp_path / "ws" / "demo" / "nodes" / "done").write_text("#!/bin/sh\necho finished\n")
-    (tmp_path / "ws" / "demo" / "nodes" / "done").chmod(0o755)
+    add_node(tmp_path, "done", "#!/bin/sh\necho finished\n")
     (tmp_path / "job.launch").write_text(
         '<launch><node pkg="demo" type="done" name="job" required="true" output="screen"/>'
         '</launch>')
