@@ -94,9 +94,14 @@ def test_ctrl_c_in_cores_first_moments_stops_it_and_its_master(moment):
         proc = subprocess.Popen([sys.executable, "-m", "orchestra", "core", "-p", str(port),
                                  "--no-rosout"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                 text=True, env=env)
-        wait_for_cpu(proc, moment)
-        proc.send_signal(signal.SIGINT)
-        out, err = proc.communicate(timeout=30)
+        try:
+            wait_for_cpu(proc, moment)
+            proc.send_signal(signal.SIGINT)
+            out, err = proc.communicate(timeout=30)
+        finally:   # a failed wait must not leave a core serving
+            if proc.poll() is None:
+                proc.kill()
+                proc.communicate()
         # -SIGINT: before Python's own handler existed; 130: during the imports; 0: stopped
         assert proc.returncode in (-signal.SIGINT, 130, 0), err
         assert "Traceback" not in err and "Exception ignored" not in err, err
