@@ -60,24 +60,33 @@ def free_port() -> int:
         return sock.getsockname()[1]
 
 
+def write_package_xml(pkg: str, name: str) -> None:
+    with open(os.path.join(pkg, "package.xml"), "w") as fh:
+        fh.write(f"<package format='2'><name>{name}</name><version>0.0.0</version>"
+                 "<description>b</description><maintainer email='a@b.c'>a</maintainer>"
+                 "<license>BSD</license></package>")
+
+
+def write_launch(path: str, nodes: list[tuple[str, str, str]]) -> str:
+    """A launch file of ``(pkg, type, name)`` nodes; returns ``path``."""
+    with open(path, "w") as fh:
+        fh.write("<launch>\n")
+        for pkg, kind, name in nodes:
+            fh.write(f'  <node pkg="{pkg}" type="{kind}" name="{name}"/>\n')
+        fh.write("</launch>\n")
+    return path
+
+
 def make_workspace(root: str, n: int) -> str:
     pkg = os.path.join(root, "ws", "benchpkg")
     os.makedirs(os.path.join(pkg, "nodes"))
-    with open(os.path.join(pkg, "package.xml"), "w") as fh:
-        fh.write("<package format='2'><name>benchpkg</name><version>0.0.0</version>"
-                 "<description>b</description><maintainer email='a@b.c'>a</maintainer>"
-                 "<license>BSD</license></package>")
+    write_package_xml(pkg, "benchpkg")
     node = os.path.join(pkg, "nodes", "idle")
     with open(node, "w") as fh:
         fh.write("#!/bin/sh\nexec sleep 1000\n")
     os.chmod(node, 0o755)
-    launch = os.path.join(root, "bench.launch")
-    with open(launch, "w") as fh:
-        fh.write("<launch>\n")
-        for i in range(n):
-            fh.write(f'  <node pkg="benchpkg" type="idle" name="n{i:03d}"/>\n')
-        fh.write("</launch>\n")
-    return launch
+    return write_launch(os.path.join(root, "bench.launch"),
+                        [("benchpkg", "idle", f"n{i:03d}") for i in range(n)])
 
 
 def cold_start_and_idle_cpu(n: int, idle: float) -> dict[str, float]:
@@ -238,13 +247,8 @@ def build_native_node(root: str) -> bool:
 
 
 def make_native_launch(root: str, n: int) -> str:
-    launch = os.path.join(root, f"native_{n}.launch")
-    with open(launch, "w") as fh:
-        fh.write("<launch>\n")
-        for i in range(n):
-            fh.write(f'  <node pkg="rbench" type="native" name="c{i:03d}"/>\n')
-        fh.write("</launch>\n")
-    return launch
+    return write_launch(os.path.join(root, f"native_{n}.launch"),
+                        [("rbench", "native", f"c{i:03d}") for i in range(n)])
 
 
 def make_py_workspace(root: str, n: int, stubborn: int = 0) -> str:
@@ -252,24 +256,15 @@ def make_py_workspace(root: str, n: int, stubborn: int = 0) -> str:
     ``n`` sleepers plus ``stubborn`` SIGINT-ignoring nodes. Returns the launch file."""
     pkg = os.path.join(root, "ws", "rbench")
     os.makedirs(os.path.join(pkg, "scripts"), exist_ok=True)
-    with open(os.path.join(pkg, "package.xml"), "w") as fh:
-        fh.write("<package format='2'><name>rbench</name><version>0.0.0</version>"
-                 "<description>b</description><maintainer email='a@b.c'>a</maintainer>"
-                 "<license>BSD</license></package>")
+    write_package_xml(pkg, "rbench")
     for name in ("sleeper", "stubborn"):
         path = os.path.join(pkg, "scripts", name)
         with open(path, "w") as fh:
             fh.write(PY_NODE)
         os.chmod(path, 0o755)
-    launch = os.path.join(root, f"py_{n}_{stubborn}.launch")
-    with open(launch, "w") as fh:
-        fh.write("<launch>\n")
-        for i in range(n):
-            fh.write(f'  <node pkg="rbench" type="sleeper" name="s{i:03d}"/>\n')
-        for i in range(stubborn):
-            fh.write(f'  <node pkg="rbench" type="stubborn" name="x{i:02d}"/>\n')
-        fh.write("</launch>\n")
-    return launch
+    return write_launch(os.path.join(root, f"py_{n}_{stubborn}.launch"),
+                        [("rbench", "sleeper", f"s{i:03d}") for i in range(n)]
+                        + [("rbench", "stubborn", f"x{i:02d}") for i in range(stubborn)])
 
 
 def node_procs(launcher: psutil.Process) -> list[psutil.Process]:
