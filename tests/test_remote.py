@@ -187,6 +187,30 @@ def test_agent_runs_the_node_through_the_client_and_stops_it_when_the_client_die
     assert not os.path.exists(os.path.dirname(sock))
 
 
+def test_release_request_stops_the_agents_nodes_and_ends_the_agent(package):
+    node = Node("adem", "stopper", "s", args="x")
+    agent_proc, _, sock = start_agent([node], package)
+    data = {"node": payload.node_to_data(node), "master_uri": "http://10.0.0.1:11311/",
+            "run_id": "r3", "log_name": "s-1", "sigint_timeout": 5, "sigterm_timeout": 1}
+    client = subprocess.Popen([sys.executable, "-I", "-S", CLIENT, sock, payload.encode(data)],
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    try:
+        assert client.stdout.readline() == b"up\n"
+        with socket.socket(socket.AF_UNIX) as conn:            # what the session's close() sends
+            conn.connect(sock)
+            conn.sendall(agent.RELEASE_REQUEST)
+        assert agent_proc.wait(timeout=10) == 0                 # ended on its own, channel open
+        assert client.wait(timeout=10) == 0                     # the node stopped in order
+        log = package / "log" / "r3" / "s-1-stdout.log"
+        assert b"got SIGINT" in log.read_bytes()
+    finally:
+        client.kill()
+        client.communicate()
+        agent_proc.kill()
+        agent_proc.communicate()
+    assert not os.path.exists(os.path.dirname(sock))
+
+
 def test_node_exit_status_reaches_the_client(package):
     node = Node("adem", "stopper", "s")
     (package / "ws" / "adem" / "three").write_text(f"#!{sys.executable}\nimport sys\n"

@@ -136,10 +136,13 @@ def leftovers(bed) -> list[int]:
 
 
 def assert_nothing_left(bed, within: float = 5.0) -> None:
-    """After a run has ended: nothing of it left in either namespace. The remote agent ends
-    on sshd's SIGHUP a moment after the launch's ssh client has gone (the launch does not
-    wait for that), so this waits briefly; it failed often once the launch's own exit got
-    faster (gc.freeze)."""
+    """After a run has ended: nothing of it left in either namespace. The launch asks its
+    remote agent to end and waits for that before it exits, so no agent may be left at
+    all; the remote sshd's own processes for the connection end a moment after it closes,
+    so those are waited for briefly."""
+    agents = [pid for pid in bed.pids_in(bed.remote_ns)
+              if b"orchestra.remote.agent" in cmdline(pid)]
+    assert [cmdline(pid) for pid in agents] == []
     deadline = time.monotonic() + within
     while leftovers(bed) and time.monotonic() < deadline:
         time.sleep(0.02)

@@ -69,6 +69,8 @@ from orchestra.supervise.status import ProcessStats
 
 _READ = 65536
 STATS_REQUEST = b"stats\n"      # instead of a node payload: the agent answers with stats
+#: instead of a node payload: the run is over, stop every node and end (the session's close)
+RELEASE_REQUEST = b"release\n"
 
 def node_environment(base: Mapping[str, str], node: Node, master_uri: str, address: str,
                      mark: str | None, executable: str) -> dict[str, str]:
@@ -309,6 +311,10 @@ class Agent:
             return
         if data == STATS_REQUEST:
             self._answer_stats(conn)
+            return
+        if data == RELEASE_REQUEST:
+            conn.close()
+            self._stop_all()
             return
         try:
             run = self._start(payload.decode(data.decode().strip()), conn)

@@ -48,7 +48,7 @@ from typing import Any
 from orchestra.errors import Location, OrchestraError
 from orchestra.launch.plan import Machine, Node
 from orchestra.remote import payload, ssh
-from orchestra.remote.agent import STATS_REQUEST
+from orchestra.remote.agent import RELEASE_REQUEST, STATS_REQUEST
 from orchestra.supervise.reaper import setpriv_prefix
 
 logger = logging.getLogger(__name__)
@@ -303,6 +303,7 @@ class RemoteSession:
         """Wait until nothing of the run is left remotely (bounded), then disconnect."""
         if reap and self.mark:
             self._reap()
+        self._release_agents()
         helpers = [p for entry in self.machines.values() for p in (entry.agent, entry.master)
                    if p is not None]
         for popen in helpers:
@@ -315,6 +316,30 @@ class RemoteSession:
                 popen.kill()
                 popen.communicate()
         shutil.rmtree(self.dir, ignore_errors=True)
+
+    def _release_agents(self, timeout: float = 5.0) -> None:
+        """Ask every agent to end and wait (bounded) until it has, so that nothing of the run
+        is left remotely when close() returns. Without this the agent ended only on sshd's
+        SIGHUP once our ssh client was gone: a moment after the launch had already exited."""
+        waiting = []
+        for entry in self.machines.values():
+            agent = entry.agent
+            if agent is None or agent.poll() is not None:
+                continue
+            try:
+                with socket.socket(socket.AF_UNIX) as sock:
+                    sock.settimeout(1.0)
+                    sock.connect(entry.local_socket)
+                    sock.sendall(RELEASE_REQUEST)
+            except OSError:
+                continue          # the channel is gone: the agent ends on sshd's SIGHUP
+            waiting.append(agent)
+        deadline = time.monotonic() + timeout + self.max_stop
+        for agent in waiting:
+            try:
+                agent.wait(max(0.0, deadline - time.monotonic()))
+            except subprocess.TimeoutExpired:
+                logger.warning("a remote agent did not end in time; closing its session")
 
     def _reap(self) -> None:
         running = []
