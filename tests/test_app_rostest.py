@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import os
 import shutil
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -228,3 +229,31 @@ def test_retry_runs_a_failed_test_again_on_a_fresh_run(tmp_path):
     assert proc.returncode == 0, proc.stdout + proc.stderr
     assert verdicts(junit) == {"flaky": "passed"}
     assert "failed, retrying. Retries left: 1" in proc.stderr
+
+
+def test_ctrl_c_fails_the_running_test_skips_the_rest_reports_and_exits_130(tmp_path):
+    out = tmp_path / "junit.xml"
+    proc = subprocess.Popen([sys.executable, "-m", "orchestra", "test",
+                             str(TESTS / "interrupted.test"), "--junit-xml", str(out),
+                             "--results-dir", str(tmp_path / "results")],
+                            env=env_for(tmp_path), cwd=tmp_path, stdin=subprocess.DEVNULL,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert proc.stderr is not None
+        for line in proc.stderr:                        # the runner's progress lines
+            if "running test [hangs]" in line:
+                break
+        proc.send_signal(signal.SIGINT)
+        stdout, stderr = proc.communicate(timeout=60)
+    finally:
+        proc.kill()
+        proc.communicate()
+    assert proc.returncode == 130, stdout + stderr
+    assert "test [hangs] was interrupted: SIGINT received" in stdout
+    assert "orchestra: SIGINT received, tests stopped" in stderr
+    root = etree.parse(str(out)).getroot()
+    suites = {suite.get("name"): suite for suite in root.iter("testsuite")}
+    assert suites["hangs"].find("testcase/failure") is not None
+    skipped = suites["after"].find("testcase/skipped")
+    assert skipped is not None
+    assert left_running(tmp_path) == []

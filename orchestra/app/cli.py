@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import signal
 import sys
 from collections.abc import Callable, Iterator
 from typing import Any
@@ -380,6 +381,9 @@ def test_command(words: tuple[str, ...], junit_xml: str | None, results_dir: str
     time-limit; the summary and one combined JUnit file report every test. Exit code 0 when
     every test passed, 1 otherwise, 2 for a launch file that cannot be loaded.
     """
+    from orchestra.supervise import stop_signals
+
+    stop_signals.record()   # as launch: a Ctrl-C from here on stops the tests in order
     from orchestra.app.junit import PASSED, combined_xml, summary_lines
     from orchestra.app.options import RunOptions
     from orchestra.app.testrun import TestOptions, TestRunner, select_tests
@@ -404,4 +408,7 @@ def test_command(words: tuple[str, ...], junit_xml: str | None, results_dir: str
         fh.write(combined_xml(f"{runner.package}.{stem}", outcomes))
     click.echo("\n".join(summary_lines(outcomes, colour=sys.stdout.isatty())))
     click.echo(f"\nJUnit results: {out}")
+    if runner.interrupted:
+        echo_err(f"orchestra: {runner.interrupted} received, tests stopped")
+        sys.exit(128 + signal.Signals[runner.interrupted])
     sys.exit(0 if all(o.verdict == PASSED for o in outcomes) else 1)

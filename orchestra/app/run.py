@@ -176,6 +176,16 @@ class LaunchRun:
         assert self.report is not None
         return self.report
 
+    def kill_all(self) -> None:
+        """A second Ctrl-C during stop(): SIGKILL every process still stopping, no more
+        waiting for their timeouts (as ``orchestra launch`` does)."""
+        supervisor = self._started()
+        if not self._ended.is_set():
+            try:
+                supervisor.loop.call_threadsafe(supervisor.kill_all)
+            except OSError:
+                pass  # the loop closed meanwhile: the run is ending anyway
+
     def __enter__(self) -> LaunchRun:
         if self.supervisor is None:
             self.start()

@@ -11,6 +11,11 @@ What goes wrong is that test's verdict, never the end of the run: a ``<test>`` t
 file declares wrongly (error, with file:line), an executable that does not exist (error), a
 results file that is not valid XML (error), a test past its time-limit or whose required
 node died (failure), a test that wrote no results (failure). The other tests still run.
+
+A stop signal (Ctrl-C, SIGTERM, SIGHUP) is the end of the run, in order: the test that runs
+is stopped and fails as interrupted, its nodes are stopped as their timeouts say (a second
+signal kills them), the tests not started yet are skipped, and the summary and the JUnit
+file still say all that. rostest dies of a KeyboardInterrupt there, reporting nothing.
 """
 from __future__ import annotations
 
@@ -23,13 +28,22 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from typing import IO, Any
 
-from orchestra.app.junit import ERROR, FAILURE, PASSED, CaseResult, ResultsError, TestOutcome
+from orchestra.app.junit import (
+    ERROR,
+    FAILURE,
+    PASSED,
+    SKIPPED,
+    CaseResult,
+    ResultsError,
+    TestOutcome,
+)
 from orchestra.app.junit import parse_results as parse_results_xml
 from orchestra.app.options import RunOptions
 from orchestra.app.run import LaunchRun
 from orchestra.errors import OrchestraError
 from orchestra.launch.plan import LaunchPlan, Test
 from orchestra.rosdirs import ros_home
+from orchestra.supervise import stop_signals
 from orchestra.supervise.command import find_node_executable
 from orchestra.supervise.output import Screen
 from orchestra.supervise.reaper import (
@@ -103,6 +117,10 @@ def error_case(name: str, message: str) -> CaseResult:
     return CaseResult(name, name, ERROR, message, message)
 
 
+def skipped_case(name: str, message: str) -> CaseResult:
+    return CaseResult(name, name, SKIPPED, message=message)
+
+
 def failure_case(name: str, message: str, text: str = "") -> CaseResult:
     return CaseResult(name, name, FAILURE, message, text or message)
 
@@ -121,6 +139,7 @@ class TestRunner:
         self.screen = screen
         self.package = package_of(launch_file)
         self.results_dir = os.path.join(results_root(options), self.package)
+        self.interrupted = ""           # the stop signal that ended the tests (``SIGINT``)
 
     def run(self, tests: Sequence[Test], broken: Sequence[tuple[str, OrchestraError]]
             ) -> list[TestOutcome]:
@@ -130,6 +149,10 @@ class TestRunner:
             self.report(f"[ROSTEST] test [{label}] cannot run: {exc}")
         seen: set[str] = set()
         for test in tests:
+            if self._interrupted():
+                outcomes.append(TestOutcome(test.test_name, [skipped_case(
+                    test.test_name, f"not run: {self.interrupted} received before it started")]))
+                continue
             if test.test_name in seen:     # rostest: a second test of that name fails
                 outcomes.append(TestOutcome(test.test_name, [error_case(
                     test.test_name, f"{_where(test)}more than one <test> is named "
@@ -154,7 +177,7 @@ class TestRunner:
             started = time.monotonic()
             cases, results_file = self._attempt(test, executable)
             outcome = TestOutcome(name, cases, time.monotonic() - started, results_file, attempt)
-            if outcome.verdict == PASSED or attempt == attempts:
+            if outcome.verdict == PASSED or attempt == attempts or self._interrupted():
                 break
             self.report(f"[ROSTEST] test [{name}] failed, retrying. "
                         f"Retries left: {attempts - attempt}")
@@ -178,7 +201,30 @@ class TestRunner:
                 os.remove(results_file)
             return self._run_test(run, test, executable, results_file), results_file
         finally:
+            self._stop_run(run)
+
+    def _interrupted(self) -> bool:
+        """A stop signal came (now or earlier): no more tests, no more attempts."""
+        taken = stop_signals.take()
+        if taken and not self.interrupted:
+            self.interrupted = stop_signals.name(taken[0])
+        return bool(self.interrupted)
+
+    def _stop_run(self, run: LaunchRun) -> None:
+        """Stop the run in order; a stop signal meanwhile kills what is still stopping."""
+        stopped = threading.Event()
+
+        def stop() -> None:
             run.stop()
+            stopped.set()
+
+        threading.Thread(target=stop, daemon=True, name="orchestra test stop").start()
+        while not stop_signals.wait_event(stopped):
+            taken = stop_signals.take()
+            if taken and not self.interrupted:     # the first: this is already the orderly stop
+                self.interrupted = stop_signals.name(taken.pop(0))
+            if taken:
+                run.kill_all()
 
     def _run_test(self, run: LaunchRun, test: Test, executable: str,
                   results_file: str) -> list[CaseResult]:
@@ -229,12 +275,14 @@ class TestRunner:
 
         for target in (wait_test, wait_run):
             threading.Thread(target=target, daemon=True, name="orchestra test wait").start()
-        finished = ended.wait(time_limit)
+        finished = stop_signals.wait_event(ended, time_limit)
         code = proc.poll()
         # the run stops by itself only when a required node ended (we stop it afterwards)
         ending = run.supervisor.result if run.supervisor is not None else None
         why = ""
-        if not finished:
+        if not finished and self._interrupted():
+            why = f"was interrupted: {self.interrupted} received"
+        elif not finished:
             why = f"failed to complete in time: time-limit of {time_limit:g} s exceeded"
         elif ending is not None and code != 0:
             why = f"was stopped: the run ended during the test ({ending.reason})"

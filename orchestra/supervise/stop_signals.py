@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import signal
 import threading
+import time
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 
@@ -39,3 +40,27 @@ def take() -> list[int]:
     taken = list(_received)
     del _received[:len(taken)]
     return taken
+
+
+#: how often wait_event() looks for a recorded signal (a Ctrl-C is acted on within this)
+_SLICE = 0.05
+
+
+def wait_event(event: threading.Event, timeout: float | None = None) -> bool:
+    """Wait until ``event`` is set (True), ``timeout`` passes or a stop signal is recorded
+    (False; ``pending()`` tells which). For waits outside the supervisor's loop, such as
+    ``orchestra test`` waiting for a test. In slices, because the handler cannot set the
+    event itself: an Event's lock may be held by the very wait the signal interrupts."""
+    deadline = None if timeout is None else time.monotonic() + timeout
+    while not _received:
+        left = _SLICE if deadline is None else min(_SLICE, deadline - time.monotonic())
+        if left <= 0:
+            return event.is_set()
+        if event.wait(left):
+            return True
+    return event.is_set()
+
+
+def name(signum: int) -> str:
+    """``SIGINT`` for 2: how a stop signal is named to the user."""
+    return signal.Signals(signum).name
