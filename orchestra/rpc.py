@@ -14,6 +14,7 @@ import os
 import selectors
 import socket
 import socketserver
+import struct
 import threading
 import xmlrpc.client
 from collections.abc import Iterable, Mapping
@@ -208,26 +209,78 @@ def multicall_results(multi: xmlrpc.client.MultiCall) -> list[Any]:
 _REASONS = {200: "OK", 400: "Bad Request", 408: "Request Timeout", 411: "Length Required",
             413: "Payload Too Large", 414: "URI Too Long", 431: "Request Header Fields Too Large",
             500: "Internal Server Error", 501: "Not Implemented"}
-MAX_LINE = 65536          # a request or header line longer than this is refused
+MAX_LINE = 65536          # a request line longer than this is refused (414)
+MAX_HEAD = 65536          # and a request line plus headers longer than this (431)
 MAX_HEADERS = 100
 MAX_BODY = 64 * 2 ** 20   # a ROS call carries params, not bulk data
+_STATUS_LINES = {(version, status): f"{version} {status} {reason}\r\n".encode()
+                 for version in ("HTTP/1.0", "HTTP/1.1") for status, reason in _REASONS.items()}
+_RECV = 65536             # bytes asked of one recv (a ROS call is far smaller)
+_TIMEVAL = struct.Struct("@ll")  # SO_RCVTIMEO / SO_SNDTIMEO: struct timeval
 
 
-class AnyPathHandler(socketserver.StreamRequestHandler):
+def _os_timeouts(sock: socket.socket, seconds: float) -> None:
+    """Bound each blocking recv and send of ``sock`` to ``seconds`` in the kernel.
+
+    A Python-level timeout (``settimeout``) makes every recv and send a poll() first: two
+    more system calls per request. SO_RCVTIMEO/SO_SNDTIMEO give the same bound on a
+    blocking socket (a timed-out call raises OSError, as ``socket.timeout`` is one); where
+    the platform refuses them, the Python timeout is used instead.
+    """
+    whole = int(seconds)
+    timeval = _TIMEVAL.pack(whole, int((seconds - whole) * 1e6))
+    try:
+        sock.settimeout(None)
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVTIMEO, timeval)
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_SNDTIMEO, timeval)
+    except (OSError, AttributeError):  # pragma: no cover - not Linux/BSD
+        sock.settimeout(seconds)
+
+
+def _head_end(buffer: bytes | bytearray, start: int = 0) -> tuple[int, int]:
+    """(end of the request head, start of the body) in ``buffer``, looking from ``start``;
+    (-1, -1) while the empty line that ends the head has not arrived. Lines end with CRLF,
+    or LF alone (RFC 9112 lets a server accept that; this one always has)."""
+    crlf = buffer.find(b"\n\r\n", start)
+    lf = buffer.find(b"\n\n", start, crlf + 1 if crlf >= 0 else len(buffer))
+    if lf >= 0:
+        return lf, lf + 2
+    if crlf >= 0:
+        return crlf, crlf + 3
+    return -1, -1
+
+
+class AnyPathHandler(socketserver.BaseRequestHandler):
     """A lean HTTP/1.x handler for XML-RPC POSTs to any path (rospy and roscpp post to "/",
     others to "/RPC2").
 
     The stdlib's http.server parses every request's headers with the email package and does
     per-request bookkeeping that costs more than the XML-RPC call itself; a ROS call needs
-    only the request line, Content-Length (and Content-Encoding, Connection). The body goes to
-    the server's dispatcher (``xmlrpc_codec``: the stdlib's reading and writing, faster for
-    the documents ROS sends), whose faults are answered as XML-RPC faults, as SimpleXMLRPCServer does.
-    ``protocol_version = "HTTP/1.1"`` keeps connections open between calls (rospy's and
-    roscpp's clients reuse them); the default answers one call per connection.
+    only the request line, Content-Length (and Content-Encoding, Connection). So the
+    connection's own thread reads straight from the socket into one buffer (a ROS request
+    usually arrives in one recv: head and body), finds the head's end with ``bytes.find``,
+    answers with one ``sendall``, and reads the next request of a kept-alive connection:
+    two system calls per request, no file objects, no thread hand-off. Bytes past one
+    request (a pipelined next one) stay in the buffer for the next. The body goes to the
+    server's dispatcher (``xmlrpc_codec``: the stdlib's reading and writing, faster for the
+    documents ROS sends), whose faults are answered as XML-RPC faults, as SimpleXMLRPCServer
+    does. ``protocol_version = "HTTP/1.1"`` keeps connections open between calls (rospy's
+    and roscpp's clients reuse them); the default answers one call per connection.
+    Oversized or malformed requests get their HTTP error and the connection is closed.
     """
 
     protocol_version = "HTTP/1.0"
-    # StreamRequestHandler.timeout: seconds a connection may sit idle or take to send a call
+    timeout: float | None = None  # seconds a connection may sit idle or take to send a call
+
+    def setup(self) -> None:
+        sock: socket.socket = self.request
+        if self.timeout is not None:
+            _os_timeouts(sock, self.timeout)
+        try:  # one sendall per reply: nothing for Nagle to merge, so do not wait for ACKs
+            sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        except OSError:  # pragma: no cover - not TCP
+            pass
+        self._buffer = b""
 
     def handle(self) -> None:
         try:
@@ -238,30 +291,44 @@ class AnyPathHandler(socketserver.StreamRequestHandler):
 
     def _handle_one(self) -> bool:
         """Answer one request; True when the connection stays open for another."""
-        line = self.rfile.readline(MAX_LINE + 1)
-        while line in (b"\r\n", b"\n"):  # tolerated between requests (RFC 9112, 2.2)
-            line = self.rfile.readline(MAX_LINE + 1)
-        if not line:
-            return False
-        if len(line) > MAX_LINE:
-            return self._refuse(414)
-        parts = line.split()
+        recv = self.request.recv
+        buffer: bytes | bytearray = self._buffer
+        scanned = 0
+        while True:
+            if buffer[:1] in (b"\r", b"\n"):  # tolerated between requests (RFC 9112, 2.2)
+                buffer = buffer.lstrip(b"\r\n")
+                scanned = 0
+            head_end, body_start = _head_end(buffer, scanned)
+            if head_end >= 0:
+                break
+            if len(buffer) > MAX_HEAD:
+                return self._refuse(414 if buffer.find(b"\n", 0, MAX_LINE + 1) < 0 else 431)
+            scanned = max(0, len(buffer) - 2)  # the end marker may straddle two reads
+            chunk = recv(_RECV)
+            if not chunk:
+                return False  # the peer closed (between requests, or giving up on one)
+            if not buffer:
+                buffer = chunk  # the usual case: the whole request in one read
+            else:  # a head in pieces: grow in place, not by copying it each time
+                if type(buffer) is bytes:
+                    buffer = bytearray(buffer)
+                buffer += chunk
+        if head_end > MAX_HEAD:
+            return self._refuse(414 if buffer.find(b"\n", 0, MAX_LINE + 1) < 0 else 431)
+        data = buffer if isinstance(buffer, bytes) else bytes(buffer)
+        lines = data[:head_end].split(b"\n")
+        parts = lines[0].split()
         if len(parts) != 3 or not parts[2].startswith(b"HTTP/"):
             return self._refuse(400)
         method, _, version = parts
+        if len(lines) > MAX_HEADERS + 1:
+            return self._refuse(431)
         headers: dict[bytes, bytes] = {}
-        for _ in range(MAX_HEADERS):
-            header = self.rfile.readline(MAX_LINE + 1)
-            if len(header) > MAX_LINE:
-                return self._refuse(431)
-            if header in (b"\r\n", b"\n", b""):
-                break
+        for header in lines[1:]:
             name, colon, value = header.partition(b":")
             if not colon:
                 return self._refuse(400)
             headers[name.strip().lower()] = value.strip()
-        else:
-            return self._refuse(431)
         if method != b"POST":
             return self._refuse(501)
         length = headers.get(b"content-length")
@@ -272,9 +339,21 @@ class AnyPathHandler(socketserver.StreamRequestHandler):
         size = int(length)
         if size > MAX_BODY:
             return self._refuse(413)
-        body = self.rfile.read(size)
-        if len(body) < size:
-            return False
+        body_end = body_start + size
+        if len(data) >= body_end:
+            body = data[body_start:body_end]
+            self._buffer = data[body_end:]
+        else:  # the rest of a large body: read exactly it, in chunks (no quadratic joins)
+            chunks = [data[body_start:]]
+            missing = body_end - len(data)
+            while missing:
+                chunk = recv(min(missing, 1 << 20))
+                if not chunk:
+                    return False
+                chunks.append(chunk)
+                missing -= len(chunk)
+            body = b"".join(chunks)
+            self._buffer = b""
         encoding = headers.get(b"content-encoding", b"identity").lower()
         keep = (self.protocol_version == "HTTP/1.1" and version == b"HTTP/1.1"
                 and headers.get(b"connection", b"").lower() != b"close")
@@ -296,10 +375,11 @@ class AnyPathHandler(socketserver.StreamRequestHandler):
         return False
 
     def _send(self, status: int, body: bytes, content_type: bytes, keep: bool) -> None:
-        head = (f"{self.protocol_version} {status} {_REASONS[status]}\r\n"
-                f"Content-type: {content_type.decode()}\r\nContent-length: {len(body)}\r\n"
-                + ("" if keep else "Connection: close\r\n") + "\r\n").encode()
-        self.wfile.write(head + body)
+        """The answer in one ``sendall`` (head and body: one segment for a small reply)."""
+        self.request.sendall(
+            b"%sContent-type: %s\r\nContent-length: %d\r\n%s\r\n%s"
+            % (_STATUS_LINES[self.protocol_version, status], content_type, len(body),
+               b"" if keep else b"Connection: close\r\n", body))
 
 
 def _fault_text(exc: BaseException) -> str:
