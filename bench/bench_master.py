@@ -12,17 +12,32 @@ Two clients, each used identically for both masters, each row labelled with its 
 between servers) and ``raw``: requests written by ``xmlrpc.client.dumps`` before the clock
 starts, sent on one kept-alive HTTP/1.1 connection, the reply read up to its
 Content-Length and only its status code checked: about as little as a client can do, so
-these rows show what the servers themselves cost. Every measurement is taken ``--rounds``
+these rows show what the servers themselves cost.
+
+Where the client runs matters more than either server on this kind of machine: a call is a
+round trip, and with the client on another CPU than the master each call pays two cross-CPU
+wake-ups (on this 2-vCPU VM ~100 us together, more than rosmaster's own work), with both on
+one CPU two context switches (a few us). Left to the scheduler, the client landed on one or
+the other from run to run, and the ratios with it (getParam 1.4x-2.8x). So this process
+(every client) is pinned too: by default to the masters' CPU (``--client-cpu``), where a
+call costs the client's work + the server's work + two switches; the ``[raw, client on
+CPU n]`` rows repeat getParam/setParam with the client on another CPU, and the last line
+gives the round-trip floor of each placement: the same raw client against a do-nothing
+server (one recv, one sendall of a canned answer) pinned like the masters.
+
+Every measurement is taken ``--rounds``
 times, interleaved between the two masters; the tables show medians of the wall-clock
 figures and of the master processes' own CPU time for the same calls (psutil; far less
 sensitive than wall clock to other load on a shared machine). Skipped with a message when
 /usr/bin/rosmaster is missing (orchestra's figures still print).
 
-Usage: ``python bench/bench_master.py [--quick] [--seconds 1.0] [--rounds 5] [--cpu N]``
+Usage: ``python bench/bench_master.py [--quick] [--seconds 1.0] [--rounds 5] [--cpu N]
+[--client-cpu N]``
 """
 from __future__ import annotations
 
 import argparse
+import functools
 import itertools
 import os
 import shutil
@@ -151,6 +166,38 @@ class MasterProcess:
         self.proc.wait(10)
 
 
+_CANNED = xmlrpc.client.dumps(((1, "Parameter [/robot/gain]", 1.5),),
+                              methodresponse=True).encode()
+
+
+def floor_server(port: int) -> None:
+    """The round-trip floor: a do-nothing HTTP server, one thread, one connection at a time,
+    answering every request with a canned ROS answer (one recv, one sendall a request, as
+    little as a Python server can do). Run as ``bench_master.py --floor-server -p PORT``."""
+    answer = (b"HTTP/1.1 200 OK\r\nContent-Type: text/xml\r\nContent-Length: %d\r\n\r\n"
+              % len(_CANNED)) + _CANNED
+    with socket.create_server(("127.0.0.1", port)) as listener:
+        while True:
+            conn, _ = listener.accept()
+            conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            buffer = b""
+            with conn:
+                while chunk := conn.recv(1 << 16):
+                    buffer += chunk
+                    while (end := buffer.find(b"\r\n\r\n")) >= 0:
+                        start = buffer.lower().find(b"content-length:", 0, end) + 15
+                        size = int(buffer[start:buffer.find(b"\r\n", start)])
+                        if len(buffer) < end + 4 + size:
+                            break
+                        buffer = buffer[end + 4 + size:]
+                        conn.sendall(answer)
+
+
+def floor_process() -> MasterProcess:
+    return MasterProcess([sys.executable, os.path.abspath(__file__), "--floor-server"],
+                         dict(os.environ))
+
+
 def orchestra_master() -> MasterProcess:
     return MasterProcess([sys.executable, "-m", "orchestra", "core", "--no-rosout"],
                          dict(os.environ))
@@ -250,8 +297,10 @@ def undo(uri: str, run: Callable[[str, int, str], float], n: int, prefix: str) -
     client.close()
 
 
-def rate_cases(param_uri: str, graph_uri: str, n: int) -> list[tuple[str, Callable[[], object]]]:
-    """The calls measured on any master, through each client."""
+def rate_cases(param_uri: str, graph_uri: str, n: int, other_cpu: int | None
+               ) -> list[tuple[str, Callable[[], object], int | None]]:
+    """The calls measured on any master, through each client: (row, call, the CPU the client
+    moves to for that row; None: where this process is pinned)."""
     m = xmlrpc.client.ServerProxy(param_uri)
     g = xmlrpc.client.ServerProxy(graph_uri)
     counter = iter(range(10 ** 9))
@@ -261,20 +310,42 @@ def rate_cases(param_uri: str, graph_uri: str, n: int) -> list[tuple[str, Callab
                             for i in range(1000)])  # a new value every call, as above
     get_all = request("getParam", "/b", "/")
     state = request("getSystemState", "/b")
-    return [
-        ("[xmlrpc.client] getParam (leaf), calls/s", lambda: m.getParam("/bench", "/robot/gain")),
+    cases: list[tuple[str, Callable[[], object], int | None]] = [
+        ("[xmlrpc.client] getParam (leaf), calls/s", lambda: m.getParam("/bench", "/robot/gain"),
+         None),
         ("[xmlrpc.client] setParam (leaf), calls/s",
-         lambda: m.setParam("/bench", "/robot/gain", next(counter))),
+         lambda: m.setParam("/bench", "/robot/gain", next(counter)), None),
         ("[xmlrpc.client] getParam('/') with 1,000 params, calls/s",
-         lambda: m.getParam("/b", "/")),
+         lambda: m.getParam("/b", "/"), None),
         (f"[xmlrpc.client] getSystemState with {n:,} registrations, calls/s",
-         lambda: g.getSystemState("/b")),
-        ("[raw] getParam (leaf), calls/s", lambda: raw_m.call(get)),
-        ("[raw] setParam (leaf), calls/s", lambda: raw_m.call(next(sets))),
-        ("[raw] getParam('/') with 1,000 params, calls/s", lambda: raw_m.call(get_all)),
+         lambda: g.getSystemState("/b"), None),
+        ("[raw] getParam (leaf), calls/s", lambda: raw_m.call(get), None),
+        ("[raw] setParam (leaf), calls/s", lambda: raw_m.call(next(sets)), None),
+        ("[raw] getParam('/') with 1,000 params, calls/s", lambda: raw_m.call(get_all), None),
         (f"[raw] getSystemState with {n:,} registrations, calls/s",
-         lambda: raw_g.call(state)),
+         lambda: raw_g.call(state), None),
     ]
+    if other_cpu is not None:
+        cases += [
+            (f"[raw, client on CPU {other_cpu}] getParam (leaf), calls/s",
+             lambda: raw_m.call(get), other_cpu),
+            (f"[raw, client on CPU {other_cpu}] setParam (leaf), calls/s",
+             lambda: raw_m.call(next(sets)), other_cpu),
+        ]
+    return cases
+
+
+def measure_rate(fn: Callable[[], object], seconds: float, cpu: int | None
+                 ) -> tuple[float, int]:
+    """``rate(fn, seconds)`` with this process moved to ``cpu`` meanwhile (None: as is)."""
+    if cpu is None:
+        return rate(fn, seconds)
+    pinned = os.sched_getaffinity(0)
+    os.sched_setaffinity(0, {cpu})
+    try:
+        return rate(fn, seconds)
+    finally:
+        os.sched_setaffinity(0, pinned)
 
 
 def main() -> None:
@@ -286,16 +357,37 @@ def main() -> None:
     parser.add_argument("--registrations", type=int, default=1000)
     parser.add_argument("--cpu", type=int, default=None,
                         help="pin both masters to this CPU (default: the last; -1: no pinning)")
+    parser.add_argument("--client-cpu", type=int, default=None,
+                        help="pin this process (the clients) to this CPU (default: the "
+                             "masters'; -1: no pinning)")
     parser.add_argument("--quick", action="store_true", help="shorter measurements")
+    parser.add_argument("--floor-server", action="store_true", help=argparse.SUPPRESS)
+    parser.add_argument("-p", type=int, help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.floor_server:
+        floor_server(args.p)
+        return
     seconds = args.seconds or (0.3 if args.quick else 1.0)
     n = args.registrations
-    cpu = (os.cpu_count() or 1) - 1 if args.cpu is None else args.cpu
+    cpus = sorted(os.sched_getaffinity(0))
+    cpu = cpus[-1] if args.cpu is None else args.cpu
     if cpu >= 0 and shutil.which("taskset"):
         PIN[:] = ["taskset", "-c", str(cpu)]
+    client_cpu = cpu if args.client_cpu is None else args.client_cpu
+    other_cpu = next((c for c in cpus if c != client_cpu), None) if client_cpu >= 0 else None
+    if client_cpu >= 0:
+        os.sched_setaffinity(0, {client_cpu})
     print(ros1.load_average())
+    print(f"masters (and the floor server) on CPU {cpu if PIN else 'any'}; clients on CPU "
+          f"{client_cpu if client_cpu >= 0 else 'any'}"
+          + (f", and on CPU {other_cpu} in the [raw, client on CPU {other_cpu}] rows"
+             if other_cpu is not None else ""))
     sides: dict[str, list[MasterProcess]] = {}
+    floor: MasterProcess | None = None
+    floors: dict[int | None, list[float]] = {None: [], other_cpu: []}
+    get_body = request("getParam", "/bench", "/robot/gain")
     try:
+        floor = floor_process()
         sides["orchestra"] = [orchestra_master(), orchestra_master()]
         if ros1.tool("rosmaster") is None:
             ros1.skip("the real rosmaster", "rosmaster (ROS 1)")
@@ -303,7 +395,7 @@ def main() -> None:
             sides["rosmaster"] = [real_rosmaster(), real_rosmaster()]
         for params, graph in sides.values():
             populate(params.uri, graph.uri, n)
-        names = [name for name, _ in rate_cases("http://x/", "http://x/", n)]
+        names = [name for name, _, _ in rate_cases("http://x/", "http://x/", n, other_cpu)]
         timed = [("[xmlrpc.client] 1,000 registerPublisher, sequential, ms", register_publishers),
                  ("[xmlrpc.client] multicall of 1,000 setParam, ms", multicall_set),
                  ("[raw] 1,000 registerPublisher, sequential, ms", register_publishers_raw),
@@ -313,12 +405,18 @@ def main() -> None:
         # the masters' own CPU time: per call (rate rows, us) or per run (timed rows, ms)
         cpu: dict[str, list[list[float]]] = {side: [[] for _ in names] for side in sides}
         for round_no in range(args.rounds):
+            floor_client = RawClient(floor.uri)
+            for where in floors:
+                floors[where].append(
+                    measure_rate(functools.partial(floor_client.call, get_body), seconds,
+                                 where)[0])
+            floor_client.close()
             for side, masters in sides.items():   # interleaved
                 params, graph = masters
-                cases = rate_cases(params.uri, graph.uri, n)
-                for i, (_, fn) in enumerate(cases):
+                cases = rate_cases(params.uri, graph.uri, n, other_cpu)
+                for i, (_, fn, where) in enumerate(cases):
                     before = sum(m.cpu_seconds() for m in masters)
-                    calls_per_s, calls = rate(fn, seconds)
+                    calls_per_s, calls = measure_rate(fn, seconds, where)
                     used = sum(m.cpu_seconds() for m in masters) - before
                     results[side][i].append(calls_per_s)
                     cpu[side][i].append(used / calls * 1e6)
@@ -333,8 +431,8 @@ def main() -> None:
                     for repeat in range(TIMED_REPEATS):
                         undo(uri, run, 1000, f"/r{round_no}/{j}/{repeat}")
     finally:
-        for masters in sides.values():
-            for master in masters:
+        for master in [*(m for masters in sides.values() for m in masters), floor]:
+            if master is not None:
                 master.stop()
 
     _table(f"wall clock, median of {args.rounds} rounds", names, results)
@@ -345,6 +443,11 @@ def main() -> None:
     _table(f"the master process's CPU time, median of {args.rounds} rounds", cpu_names, cpu)
     print("ratio = orchestra / rosmaster (lower is cheaper; a master's calls/s on a CPU of "
           "its own is 1e6 / us per call)")
+    for where, rates in floors.items():
+        floor_rate = statistics.median(rates)
+        print(f"round-trip floor, client on CPU {client_cpu if where is None else where}: a "
+              f"do-nothing server answers {floor_rate:.0f} calls/s ({1e6 / floor_rate:.1f} us "
+              "a call), median")
     print(ros1.load_average())
 
 

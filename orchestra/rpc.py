@@ -425,8 +425,9 @@ class Dispatcher:
     def dispatch(self, method: str, params: tuple[Any, ...]) -> Any:
         func = self.funcs.get(method)
         if func is None and self.instance is not None:
-            if hasattr(self.instance, "_dispatch"):
-                return self.instance._dispatch(method, params)
+            own_dispatch = getattr(self.instance, "_dispatch", None)
+            if own_dispatch is not None:
+                return own_dispatch(method, params)
             if not method.startswith("_") and "." not in method:
                 func = getattr(self.instance, method, None)
         if func is None:

@@ -41,8 +41,10 @@ _DECL = re.compile(r"<\?xml[ \t\r\n]+version[ \t\r\n]*=[ \t\r\n]*(['\"])1\.0\1"
                    r"(?:[ \t\r\n]+encoding[ \t\r\n]*=[ \t\r\n]*(['\"])(?i:utf-8)\2)?"
                    r"(?:[ \t\r\n]+standalone[ \t\r\n]*=[ \t\r\n]*(['\"])(?:yes|no)\3)?"
                    r"[ \t\r\n]*\?>")
+_PLAIN_DECL = "<?xml version='1.0'?>"
 # characters XML 1.0 does not allow
 _NOT_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ufffe\uffff]").search
+_NOT_XML_ASCII = bytes([*range(0x00, 0x09), 0x0b, 0x0c, *range(0x0e, 0x20)])  # (as bytes)
 _REF = re.compile(r"&(?:(lt|gt|amp|quot|apos)|#([0-9]+)|#x([0-9a-fA-F]+));")
 _ENTITIES = {"lt": "<", "gt": ">", "amp": "&", "quot": '"', "apos": "'"}
 
@@ -92,19 +94,25 @@ _TOKEN = re.compile(
     "|(?P<end_call>methodCall>)"
     "|(?P<end_response>methodResponse>)))"
     "|(?P<other>[^ \t\n]))")
-# A call whose arguments are all scalars (most calls a master gets), matched whole: its
-# values are then found in the params part by _FLAT_VALUE, no walk needed. Same subset and
-# spacing rules as the tokens above.
+# A call whose arguments are all scalars (most calls a master gets), matched whole by the
+# pattern for its number of <param>s (the document says how many: a scalar's text cannot
+# hold a '<'): one match gives the method name and every value's type, text, untyped text
+# and nil, no walk needed. Same subset and spacing rules as the tokens above.
 _SCALAR_TYPES = ("string|int|i4|double|boolean|i8|i1|i2|biginteger|float|base64"
                  "|dateTime\\.iso8601")
-_FLAT_CALL = re.compile(
-    "[ \t\n]*<methodCall>[ \t\n]*<methodName>([^<]*)</methodName>[ \t\n]*<params>("
-    "(?:[ \t\n]*<param>[ \t\n]*<value>(?:[ \t\n]*<(" + _SCALAR_TYPES + ")>[^<]*</\\3>"
-    "[ \t\n]*|[^<]*|[ \t\n]*<nil/>[ \t\n]*)</value>[ \t\n]*</param>)*"
-    ")[ \t\n]*</params>[ \t\n]*</methodCall>")
-_FLAT_VALUE = re.compile(
-    "<value>(?:[ \t\n]*<(" + _SCALAR_TYPES + ")>([^<]*)</\\1>[ \t\n]*|([^<]*)"
-    "|[ \t\n]*(<nil/>)[ \t\n]*)</value>")
+
+
+def _flat_call(params: int) -> re.Pattern[str]:
+    one = ("[ \t\n]*<param>[ \t\n]*<value>(?:[ \t\n]*<(?P<t{0}>" + _SCALAR_TYPES
+           + ")>([^<]*)</(?P=t{0})>[ \t\n]*|([^<]*)|[ \t\n]*(<nil/>)[ \t\n]*)</value>"
+           "[ \t\n]*</param>")
+    return re.compile(
+        "[ \t\n]*<methodCall>[ \t\n]*<methodName>([^<]*)</methodName>[ \t\n]*<params>"
+        + "".join(one.format(i) for i in range(params))
+        + "[ \t\n]*</params>[ \t\n]*</methodCall>")
+
+
+_FLAT_CALLS = [_flat_call(params) for params in range(9)]
 _T = _TOKEN.groupindex
 _TYPE, _TYPED, _UNTYPED, _NIL = _T["type"], _T["typed"], _T["untyped"], _T["nil"]
 _NAME, _METHOD = _T["name"], _T["method"]
@@ -160,24 +168,35 @@ def _loads_plain(data: bytes | bytearray) -> tuple[tuple[Any, ...], str | None] 
     """The document read in one pass over its tokens, when it is in the plain subset and
     shaped as XML-RPC documents are (then the stdlib reads it the same); None (or an
     exception) otherwise, and for a fault."""
-    text = data.decode("utf-8")
-    if _NOT_XML(text) or "]]>" in text:
+    if data.isascii():  # the usual case: a C scan for control characters is enough
+        if len(data.translate(None, _NOT_XML_ASCII)) != len(data):
+            return None
+        text = data.decode("ascii")
+    else:
+        text = data.decode("utf-8")
+        if _NOT_XML(text):
+            return None
+    if "]]>" in text:
         return None
     if "\r" in text:  # XML's end-of-line handling, before references can make one
         text = text.replace("\r\n", "\n").replace("\r", "\n")
     # trailing whitespace would cost the tokenizer a retry per character (quadratic)
     text = text.rstrip(" \t\n")
     start = 0
-    if text.startswith("<?"):
+    if text.startswith(_PLAIN_DECL):  # what xmlrpc.client (and so rospy) writes
+        start = len(_PLAIN_DECL)
+    elif text.startswith("<?"):
         decl = _DECL.match(text)
         if decl is None:
             return None
         start = decl.end()
-    flat = _FLAT_CALL.fullmatch(text, start)
+    params_count = text.count("<param>")
+    flat = (_FLAT_CALLS[params_count].fullmatch(text, start)
+            if params_count < len(_FLAT_CALLS) else None)
     if flat is not None:
-        name = flat[1]
-        return (tuple([_scalar(kind or None, typed, untyped, nil)
-                       for kind, typed, untyped, nil in _FLAT_VALUE.findall(flat[2])]),
+        name, *groups = flat.groups("")
+        return (tuple([_scalar(groups[i] or None, groups[i + 1], groups[i + 2], groups[i + 3])
+                       for i in range(0, len(groups), 4)]),
                 _text(name) if "&" in name else name)
     value_token, array_token, struct_token = _T["value"], _T["array"], _T["struct"]
     param_token, end_param_token, end_array_token = _T["param"], _T["end_param"], _T["end_array"]
@@ -377,6 +396,18 @@ def _params(values: tuple[Any, ...], allow_none: bool) -> str:
 def dumps_response(result: Any, allow_none: bool = False) -> bytes:
     """The methodResponse carrying ``result``, as ``xmlrpc.client.dumps((result,),
     methodresponse=True)`` writes it, encoded as a server sends it."""
+    kind = type(result)
+    if (kind is tuple or kind is list) and len(result) == 3:
+        # a ROS answer [code, statusMessage, value] with a scalar value: most master
+        # answers, written in one piece
+        code, message, value = result
+        code_xml, message_xml, value_xml = _scalar_xml(code), _scalar_xml(message), \
+            _scalar_xml(value)
+        if code_xml and message_xml and value_xml:
+            return ("<?xml version='1.0'?>\n<methodResponse>\n<params>\n<param>\n"
+                    "<value><array><data>\n" + code_xml + message_xml + value_xml
+                    + "</data></array></value>\n</param>\n</params>\n</methodResponse>\n"
+                    ).encode("utf-8", "xmlcharrefreplace")
     try:
         body = _params((result,), allow_none)
     except _Unusual:
