@@ -267,20 +267,78 @@ def make_py_workspace(root: str, n: int, stubborn: int = 0) -> str:
                         + [("rbench", "stubborn", f"x{i:02d}") for i in range(stubborn)])
 
 
-def node_procs(launcher: psutil.Process) -> list[psutil.Process]:
-    """The launcher's descendants running one of the bench nodes (not master or rosout)."""
-    found = []
-    try:
-        children = launcher.children(recursive=True)
-    except psutil.NoSuchProcess:
+def is_node_command(argv: list[str]) -> bool:
+    """A bench node's command line (not master or rosout; setpriv's until it exec's)."""
+    return any("rbench/scripts/" in word for word in argv[:3])
+
+
+class NodeScan:
+    """Finds the launcher's descendants that run a bench node, cheaply enough not to lag.
+
+    The probe runs in its own session, so while 100 interpreters start it gets about 1/100
+    of the CPU like everything else. Listing every descendant with psutil and reading every
+    one's command line on each 5 ms poll cost several ms of CPU per poll, which then took
+    100-300 ms of wall time: the probe saw the last node of a fast launcher well after the
+    kernel exec'd it (checked against the kernel's exec timestamps, ``perf record -e
+    sched:sched_process_exec``), while for a launcher that spawns slowly the lag was ~15 ms.
+    Here each poll lists /proc, reads the parent of new pids only, and the command line of
+    descendants not yet known to run a node (exec'd once, they stay so); both launchers are
+    probed by the same code.
+    """
+
+    def __init__(self, root: int) -> None:
+        self.family = {root}
+        self.known: set[int] = {root}   # classified pids (descendants or not)
+        self.nodes: list[int] = []
+        self._matched: set[int] = set()
+        self._pending: set[int] = set()   # descendants not (yet) running a node
+
+    def poll(self) -> int:
+        """How many node processes have been seen so far (they are not re-checked)."""
+        fresh: dict[int, int] = {}
+        for entry in os.listdir("/proc"):
+            if not entry.isdigit():
+                continue
+            pid = int(entry)
+            if pid in self.known:
+                continue
+            try:
+                with open(f"/proc/{pid}/stat", "rb") as fh:
+                    stat = fh.read()
+            except OSError:
+                continue
+            fresh[pid] = int(stat[stat.rfind(b")") + 2:].split(b" ", 2)[1])
+        changed = True
+        while changed:      # a parent and its child may both be new in one listing
+            changed = False
+            for pid, ppid in list(fresh.items()):
+                if ppid in self.family:
+                    self.family.add(pid)
+                    self._pending.add(pid)
+                    del fresh[pid]
+                    changed = True
+        self.known.update(self.family)
+        self.known.update(fresh)       # not descendants: their ancestry cannot change to ours
+        for pid in list(self._pending):
+            try:
+                with open(f"/proc/{pid}/cmdline", "rb") as fh:
+                    argv = fh.read().decode(errors="replace").split("\0")
+            except OSError:
+                self._pending.discard(pid)
+                continue
+            if is_node_command(argv):
+                self._pending.discard(pid)
+                self.nodes.append(pid)
+        return len(self.nodes)
+
+    def processes(self) -> list[psutil.Process]:
+        found = []
+        for pid in self.nodes:
+            try:
+                found.append(psutil.Process(pid))
+            except psutil.NoSuchProcess:
+                pass
         return found
-    for child in children:
-        try:
-            if any("rbench/scripts/" in word for word in child.cmdline()[:3]):
-                found.append(child)
-        except (psutil.NoSuchProcess, psutil.AccessDenied, psutil.ZombieProcess):
-            pass
-    return found
 
 
 def alive(procs: list[psutil.Process]) -> list[psutil.Process]:
@@ -322,16 +380,18 @@ class Launcher:
 
     def wait_running(self, n: int, limit: float = 60.0) -> float:
         """Seconds from Popen until ``n`` node processes run (raises past ``limit``)."""
-        while True:
-            procs = node_procs(self.ps)
-            for proc in procs:
+        scan = NodeScan(self.proc.pid)
+        try:
+            while True:
+                if scan.poll() >= n:
+                    return time.perf_counter() - self.t0
+                if self.proc.poll() is not None or time.perf_counter() - self.t0 > limit:
+                    raise RuntimeError(f"{self.kind}: {len(scan.nodes)} of {n} nodes after "
+                                       f"{time.perf_counter() - self.t0:.1f} s")
+                time.sleep(0.005)
+        finally:
+            for proc in scan.processes():
                 self.seen[proc.pid] = proc
-            if len(procs) >= n:
-                return time.perf_counter() - self.t0
-            if self.proc.poll() is not None or time.perf_counter() - self.t0 > limit:
-                raise RuntimeError(f"{self.kind}: {len(procs)} of {n} nodes after "
-                                   f"{time.perf_counter() - self.t0:.1f} s")
-            time.sleep(0.005)
 
     def everything(self) -> list[psutil.Process]:
         try:
