@@ -20,6 +20,9 @@
    cost; skipped without a compiler); a launch whose nodes ignore SIGINT (default timeouts,
    then ``--sigint-timeout``); and the processes left running after the launcher is
    SIGKILLed (orphans, then killed). Skipped with a message when roslaunch is missing.
+   With each start row, where the CPU went until the last node ran (the scheduler's own
+   accounting, /proc/PID/task/TID/schedstat): the launcher process, its other processes,
+   the nodes, and what the cores had in that time.
 """
 from __future__ import annotations
 
@@ -352,6 +355,28 @@ def alive(procs: list[psutil.Process]) -> list[psutil.Process]:
     return out
 
 
+def schedstat(pid: int) -> tuple[float, float]:
+    """(ms on a CPU, ms runnable but not running) of all threads of ``pid`` so far.
+
+    From the scheduler's own accounting (``/proc/PID/task/TID/schedstat``): how much CPU a
+    process got while the nodes started, and how long it waited for one while it could run.
+    """
+    ran = waited = 0
+    try:
+        tids = os.listdir(f"/proc/{pid}/task")
+    except OSError:
+        return 0.0, 0.0
+    for tid in tids:
+        try:
+            with open(f"/proc/{pid}/task/{tid}/schedstat") as fh:
+                fields = fh.read().split()
+        except OSError:
+            continue
+        ran += int(fields[0])
+        waited += int(fields[1])
+    return ran / 1e6, waited / 1e6
+
+
 class Launcher:
     """One ``roslaunch`` or ``orchestra launch`` run of a launch file, on its own port."""
 
@@ -376,6 +401,7 @@ class Launcher:
                                      start_new_session=True)
         self.ps = psutil.Process(self.proc.pid)
         self.seen: dict[int, psutil.Process] = {}    # node processes
+        self.cpu: dict[str, float] = {}   # where the CPU went until all nodes ran (ms)
         self.others: list[psutil.Process] = []       # master, rosout: orphans once it is killed
 
     def wait_running(self, n: int, limit: float = 60.0) -> float:
@@ -384,7 +410,9 @@ class Launcher:
         try:
             while True:
                 if scan.poll() >= n:
-                    return time.perf_counter() - self.t0
+                    took = time.perf_counter() - self.t0
+                    self.cpu = self._accounting(scan.nodes, took)
+                    return took
                 if self.proc.poll() is not None or time.perf_counter() - self.t0 > limit:
                     raise RuntimeError(f"{self.kind}: {len(scan.nodes)} of {n} nodes after "
                                        f"{time.perf_counter() - self.t0:.1f} s")
@@ -392,6 +420,19 @@ class Launcher:
         finally:
             for proc in scan.processes():
                 self.seen[proc.pid] = proc
+
+    def _accounting(self, nodes: list[int], took: float) -> dict[str, float]:
+        """CPU (ms) of the launcher process, of its other processes (master, rosout,
+        watchdog) and of the nodes, from its start until every node ran; and the CPU time
+        the machine had meanwhile (cores x wall)."""
+        launcher, launcher_wait = schedstat(self.proc.pid)
+        others = 0.0
+        for proc in self.everything():
+            if proc.pid not in nodes:
+                others += schedstat(proc.pid)[0]
+        return {"launcher": launcher, "launcher waiting": launcher_wait, "others": others,
+                "nodes": sum(schedstat(pid)[0] for pid in nodes),
+                "available": (os.cpu_count() or 1) * took * 1e3}
 
     def everything(self) -> list[psutil.Process]:
         try:
@@ -448,11 +489,13 @@ def real_roslaunch_comparison(n: int, quick: bool) -> list:
         repeat = 3 if quick else 5
         for what, file in launches:
             times: dict[str, dict[str, list[float]]] = {}
+            cpu: dict[str, list[dict[str, float]]] = {}
             for _ in range(repeat):
                 for kind in ("orchestra", "roslaunch"):
                     run = Launcher(kind, file, root)
                     try:
                         started = run.wait_running(n)
+                        cpu.setdefault(kind, []).append(run.cpu)
                         time.sleep(1.0)  # let the launcher settle (registrations, rosout)
                         took, left = run.stop(40)
                     finally:
@@ -467,6 +510,13 @@ def real_roslaunch_comparison(n: int, quick: bool) -> list:
                              kind, statistics.median(figures["start"])])
                 rows.append([f"SIGINT to launcher -> launcher and {n} {what} nodes gone "
                              f"(median of {repeat})", kind, statistics.median(figures["stop"])])
+            for kind, runs in cpu.items():
+                med = {key: statistics.median(r[key] for r in runs) for key in runs[0]}
+                rows.append([f"  CPU until all {what} nodes ran (ms, medians)", kind, None,
+                             f"launcher {med['launcher']:.0f} (its threads runnable, not running: "
+                             f"{med['launcher waiting']:.0f}), master/rosout/helpers "
+                             f"{med['others']:.0f}, nodes {med['nodes']:.0f}, "
+                             f"of {med['available']:.0f} on {os.cpu_count()} cores"])
         # SIGINT-ignoring nodes: default escalation, then --sigint-timeout
         stubborn = 3
         launch_x = make_py_workspace(root, 10, stubborn)
@@ -565,7 +615,11 @@ def main() -> None:
         print(f"\n{'against real roslaunch (same launch file)':<80} {'orchestra':>10} "
               f"{'roslaunch':>10} {'ratio':>7}  target")
         for what, ours, theirs, note in real_rows:
-            if ours is None or theirs is None:
+            if ours is None and theirs is None:     # notes only: one line per launcher
+                print(what)
+                for part in note.split("; "):
+                    print(f"    {part}")
+            elif ours is None or theirs is None:
                 print(f"{what:<80} {note}")
             elif isinstance(ours, int):
                 print(f"{what:<80} {ours:>10} {theirs:>10} {'':>7}  {note}")
