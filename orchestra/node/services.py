@@ -19,6 +19,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from orchestra.node import context, names, tcpros
+from orchestra.node.busypoll import BusyPoll
 from orchestra.node.exceptions import (
     ROSException,
     ROSInterruptException,
@@ -97,13 +98,21 @@ class ServiceServer:
                                 f"[{cls._md5sum}]")
             return
         persistent = header.get("persistent") == "1"
+        # a kept connection's next request often follows the reply within microseconds
+        poll = BusyPoll() if persistent else None
         with self.lock:
             self.sockets.add(sock)
         try:
             tcpros.write_header(sock, self.header())
             while not self.closed:
                 try:
-                    data = reader.message()
+                    if poll is None:
+                        data = reader.message()
+                    else:
+                        start = time.perf_counter_ns()
+                        reader.poll(poll.budget())
+                        data = reader.message()
+                        poll.waited(start)
                 except TransportException:
                     return
                 self._answer(sock, data, caller)
@@ -189,9 +198,15 @@ class _Connection:
         self.header = header
         return self
 
-    def call(self, body: bytes | bytearray) -> tuple[bool, bytes]:
+    def call(self, body: bytes | bytearray, poll: BusyPoll) -> tuple[bool, bytes]:
+        """Send one request, read its reply (polled for first when ``poll`` says the
+        service answers fast)."""
         tcpros.send_message(self.sock, body)
-        return self.reader.service_response()
+        start = time.perf_counter_ns()
+        self.reader.poll(poll.budget())
+        reply = self.reader.service_response()
+        poll.waited(start)
+        return reply
 
     def close(self) -> None:
         self.sock.close()
@@ -321,6 +336,7 @@ class ServiceProxy:
         self._hello = tcpros.encode_header(fields)
         self._conn: _Connection | None = None
         self._last_uri: str | None = None  # where the service was found last
+        self._poll = BusyPoll()  # how fast the service answered last
         self._lock = threading.Lock()
 
     def wait_for_service(self, timeout: float | None = None) -> None:
@@ -347,7 +363,7 @@ class ServiceProxy:
                 conn = _open(self._rt.master, self.name, self._hello, last)
                 self._last_uri = conn.uri
             try:
-                ok, reply = conn.call(body)
+                ok, reply = conn.call(body, self._poll)
             except (OSError, TransportException) as exc:
                 conn.close()
                 self._conn = None

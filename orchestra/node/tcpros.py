@@ -10,6 +10,7 @@ from __future__ import annotations
 import socket
 import struct
 
+from orchestra.node import busypoll
 from orchestra.node.exceptions import TransportException
 
 _U32 = struct.Struct("<I")
@@ -167,6 +168,16 @@ class Reader(_Framing):
         self.sock = sock
         self._data = b""
         self._pos = 0
+
+    def poll(self, budget_ns: int) -> None:
+        """When nothing is buffered, poll the socket up to ``budget_ns`` for what comes
+        next (``busypoll``: an answer due within microseconds is read without the thread
+        sleeping); what arrives is buffered for ``exact``."""
+        if budget_ns <= 0 or self._pos < len(self._data):
+            return
+        chunk = busypoll.poll_recv(self.sock, self.CHUNK, budget_ns)
+        if chunk:  # (b"": the peer closed; the next read finds that out again)
+            self._data, self._pos = chunk, 0
 
     def exact(self, size: int) -> bytes:
         """The next ``size`` bytes; ``TransportException`` when the peer closes first."""

@@ -1,0 +1,71 @@
+"""Polling a connection briefly before blocking on it, when the answer is due within microseconds.
+
+A thread that blocks in ``recv`` gives its CPU up; when the CPU has nothing else to run it
+halts, and the answer's arrival then pays a cross-CPU wake-up (an interrupt to the halted
+CPU, and in a virtual machine an exit to the hypervisor) before the thread runs again: on
+the 2-core VM of docs/benchmarks.md that was ~40 of the ~100 µs of a kept-alive service call
+between two pinned processes, for rospy as for us, while each side's own work (Python and
+the two socket calls) is ~30 µs. Polling the socket for a bounded while instead keeps the
+thread running, so the answer is read as soon as it lands; the kernel offers the same for
+network cards (``SO_BUSY_POLL``), not for loopback.
+
+The rule is adaptive and bounded, so a slow or rarely used peer costs nothing: a wait is
+polled only when the previous wait on the same link ended within ``LIMIT_NS`` (the peer
+answers fast), and never for longer than that; otherwise the thread blocks at once, as it
+always did. The time of every wait is measured either way, so a peer that becomes fast is
+polled again from the next call on. On a machine with one CPU nothing polls: the peer needs
+that CPU to answer. Between polls the thread yields its CPU, so a peer (or anything else)
+runnable on the same CPU runs first.
+"""
+from __future__ import annotations
+
+import os
+import socket
+import time
+
+#: longest poll of one wait (ns); a peer that answers later is waited for blocked
+LIMIT_NS = 100_000
+
+
+def _multi_cpu() -> bool:
+    """Whether the machine has more than one CPU (on a sole CPU polling only delays the
+    peer that must answer). A process pinned to one CPU of several still polls: its peer
+    is as likely elsewhere, and a peer on the same CPU runs when the poll yields."""
+    return (os.cpu_count() or 1) > 1
+
+
+class BusyPoll:
+    """The polling decision for one link (a service connection, a proxy's calls): poll the
+    next wait when the last one ended within the limit."""
+
+    __slots__ = ("limit_ns", "last_ns")
+
+    def __init__(self, limit_ns: int = LIMIT_NS):
+        self.limit_ns = limit_ns if _multi_cpu() else 0
+        self.last_ns = 0  # how long the previous wait took; 0: none yet (poll)
+
+    def budget(self) -> int:
+        """How long to poll the next wait (ns); 0: block at once."""
+        return self.limit_ns if self.last_ns < self.limit_ns else 0
+
+    def waited(self, start_ns: int) -> None:
+        """Record that the wait begun at ``start_ns`` (``time.perf_counter_ns``) is over."""
+        self.last_ns = time.perf_counter_ns() - start_ns
+
+
+def poll_recv(sock: socket.socket, size: int, budget_ns: int) -> bytes | None:
+    """Up to ``size`` bytes that arrive on ``sock`` within ``budget_ns``, without blocking;
+    None when nothing came (b"" when the peer closed). ``sock`` must be in blocking mode
+    (no timeout), as connections are once their headers are exchanged."""
+    end = time.perf_counter_ns() + budget_ns
+    recv, flags, clock = sock.recv, socket.MSG_DONTWAIT, time.perf_counter_ns
+    while True:
+        try:
+            return recv(size, flags)
+        except BlockingIOError:
+            if clock() >= end:
+                return None
+            _yield_cpu()
+
+
+_yield_cpu = getattr(os, "sched_yield", lambda: None)
