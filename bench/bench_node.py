@@ -8,6 +8,8 @@ machines; absolute numbers depend on the CPU and on what else runs.
 
     python bench/bench_node.py            # full run (~5 minutes)
     python bench/bench_node.py --quick    # fewer samples (~2 minutes)
+    python bench/bench_node.py --rows service    # only the rospy service rows (issue 15)
+    python bench/bench_node.py --rows twist100   # only the rospy 100 Hz latency rows
 
 Processes: an in-process master, then a publisher process and a subscriber process (or a
 service and a client process). One-way latency = receive time - send time, both read from
@@ -26,6 +28,14 @@ runs on CPU 0, every subscriber and service on CPU 1, and this process (the mast
 halves with where the scheduler happens to put the two processes (same CPU: a direct switch;
 two CPUs: a cross-CPU wake-up per message), which made persistent service calls bimodal
 (0.4-3.2x from one run to the next). ``--pin none`` leaves placement to the scheduler.
+
+Service and 100 Hz rows run every pair in each of ``--rounds`` rounds, the pairs' order
+rotated each round; they print each round (with the load average when it began), the
+medians, and each round's ratio against rospy->rospy as ``median [min-max]``: one round
+that another process spoiled shows as such instead of deciding the figure. A round makes
+``--calls`` plain and ``--persistent-calls`` persistent calls per pair (a kept connection's
+call is ~10x faster, so 10x as many make a round of similar length), and the client's CPU
+per call is printed next to the rates.
 """
 from __future__ import annotations
 
@@ -207,22 +217,24 @@ def role_service() -> None:
     rospy.signal_shutdown("done")
 
 
-def role_client(calls: int) -> None:
+def role_client(calls: int, persistent_calls: int) -> None:
     rospy = node_api()
     SetBool, _ = service_classes("std_srvs/SetBool")
     rospy.init_node("bench_client", disable_signals=True)
     rospy.wait_for_service("/bench_srv", timeout=10)
-    out = {}
-    for persistent in (False, True):
+    out, cpu = {}, {}
+    for persistent, n in ((False, calls), (True, persistent_calls)):
+        key = "persistent" if persistent else "plain"
         proxy = rospy.ServiceProxy("/bench_srv", SetBool, persistent=persistent)
         proxy(data=True)
-        start = now()
-        for _ in range(calls):
+        start, start_cpu = now(), time.process_time()
+        for _ in range(n):
             assert proxy(data=True).success
-        out["persistent" if persistent else "plain"] = calls / (now() - start)
+        out[key] = n / (now() - start)
+        cpu[key] = (time.process_time() - start_cpu) / n * 1e6  # the client's, all threads
         if persistent:
             proxy.close()
-    emit({"calls_per_s": out})
+    emit({"calls_per_s": out, "client_cpu_us": cpu})
     rospy.signal_shutdown("done")
 
 
@@ -368,7 +380,17 @@ def main() -> None:
     parser.add_argument("--count", type=int, default=2000)
     parser.add_argument("--burst", type=int, default=5000)
     parser.add_argument("--size", type=int, default=48)
-    parser.add_argument("--calls", type=int, default=2000)
+    parser.add_argument("--calls", type=int, default=2000,
+                        help="plain service calls per round (a connection each)")
+    parser.add_argument("--persistent-calls", type=int, default=20000,
+                        help="persistent service calls per round (~10x as many: a kept "
+                             "connection's call is ~10x faster, and a round must last long "
+                             "enough that one scheduler hiccup does not decide it)")
+    parser.add_argument("--rows", default="all", choices=("all", "service", "twist100"),
+                        help="all rows, or only the rospy service rows or the 100 Hz rows "
+                             "(issue 15's node rows; each with its rounds and spread)")
+    parser.add_argument("--rounds", type=int, default=5,
+                        help="interleaved rounds of the service and 100 Hz rows")
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--impl", default="orchestra", choices=("orchestra", "rospy"),
                         help="(child roles) the node API to use")
@@ -391,7 +413,7 @@ def main() -> None:
     if opts.role == "service":
         return role_service()
     if opts.role == "client":
-        return role_client(opts.calls)
+        return role_client(opts.calls, opts.persistent_calls)
     if opts.role == "raw_server":
         return role_raw_server(opts.size, opts.count, opts.burst)
 
@@ -403,48 +425,133 @@ def main() -> None:
     from orchestra.master import start_master
     master = start_master(host="127.0.0.1", port=0)
     env = dict(os.environ, ROS_MASTER_URI=master.uri, PYTHONUNBUFFERED="1")
-    results: dict = {"pinning": describe_pinning()}
+    results: dict = {"pinning": describe_pinning(), "load_start": os.getloadavg()}
+    plan = {"twist": (int(2000 * scale), int(5000 * scale), 48, 0.002),
+            "image": (int(200 * scale), int(300 * scale), IMAGE_BYTES + 70, 0.01)}
+    calls = int(opts.calls * scale)
+    persistent_calls = int(opts.persistent_calls * scale)
     try:
-        plan = {"twist": (int(2000 * scale), int(5000 * scale), 48, 0.002),
-                "image": (int(200 * scale), int(300 * scale), IMAGE_BYTES + 70, 0.01)}
-        for kind, (count, burst, size, gap) in plan.items():
-            results[kind] = bench_topic(env, kind, count, burst, gap)
-            results[kind]["baseline"] = raw_baseline(size, count, burst, 10, gap)
-        calls = int(opts.calls * scale)
-        results["service"] = bench_service(env, calls)
-        results["service"]["baseline"] = raw_baseline(8, 1, 2, calls, 0)["calls_per_s"]
+        if opts.rows == "all":
+            for kind, (count, burst, size, gap) in plan.items():
+                results[kind] = bench_topic(env, kind, count, burst, gap)
+                results[kind]["baseline"] = raw_baseline(size, count, burst, 10, gap)
+            results["service"] = bench_service(env, calls, persistent_calls)
+            results["service"]["baseline"] = raw_baseline(
+                8, 1, 2, persistent_calls, 0)["calls_per_s"]
         import ros1
         if ros1.has_modules("rospy", "geometry_msgs.msg", "sensor_msgs.msg", "std_srvs.srv"):
-            results["ros1"] = {}
-            for kind, (count, burst, _, gap) in plan.items():
-                for pub_impl, sub_impl in PAIRS[1:]:
-                    results["ros1"][f"{kind} {pub_impl}->{sub_impl}"] = bench_topic(
-                        env, kind, count, burst, gap, pub_impl, sub_impl)
-            # Twist at 100 Hz (a robot's cmd_vel): latency only, every pair in each of
-            # ROUNDS interleaved rounds; the rounds' samples pooled per pair (a p99 of one
-            # 6 s round is its 6th-worst message: one scheduler hiccup moves it by ms)
-            slow = int(SLOW_TWIST_COUNT * scale)
-            pooled: dict[str, list[float]] = {}
-            for _ in range(ROUNDS):
-                for pub_impl, sub_impl in PAIRS:
-                    got = bench_topic(env, "twist", slow, 0, 0.01, pub_impl, sub_impl)
-                    pooled.setdefault(f"twist100 {pub_impl}->{sub_impl}", []).extend(
-                        got["samples"])
-            for key, samples in pooled.items():
-                results["ros1"][key] = summarize(samples)
-            # service pairs interleaved over ROUNDS rounds, medians kept (the shared
-            # machine's load swings single runs by 2x); orchestra->orchestra included
-            for _ in range(ROUNDS):
-                for cli_impl, svc_impl in PAIRS:
-                    got = bench_service(env, calls, svc_impl, cli_impl)
-                    results["ros1"].setdefault(f"service {cli_impl}->{svc_impl}", []).append(got)
+            if opts.rows == "all":
+                results["ros1"] = {}
+                for kind, (count, burst, _, gap) in plan.items():
+                    for pub_impl, sub_impl in PAIRS[1:]:
+                        results["ros1"][f"{kind} {pub_impl}->{sub_impl}"] = bench_topic(
+                            env, kind, count, burst, gap, pub_impl, sub_impl)
+            if opts.rows in ("all", "twist100"):
+                results["twist100"] = twist100_rounds(env, int(SLOW_TWIST_COUNT * scale),
+                                                      opts.rounds)
+            if opts.rows in ("all", "service"):
+                results["services"] = service_rounds(env, calls, persistent_calls, opts.rounds)
         else:
             ros1.skip("rospy comparisons", "rospy (with geometry_msgs, sensor_msgs, std_srvs)")
     finally:
         master.shutdown()
+    results["load_end"] = os.getloadavg()
     if opts.json:
         print(json.dumps(results, indent=2))
         return
+    if opts.rows == "all":
+        print_baseline(results, plan)
+    if "ros1" in results:
+        print_ros1(results, plan)
+    if "twist100" in results:
+        print_twist100(results["twist100"])
+    if "services" in results:
+        print_services(results["services"])
+    print(results["pinning"])
+    print(f"load average (1 min) {results['load_start'][0]:.2f} at the start, "
+          f"{results['load_end'][0]:.2f} at the end, on {os.cpu_count()} cores")
+
+
+SLOW_TWIST_COUNT = 600  # messages per 100 Hz latency run (6 s; --quick: a quarter)
+
+PAIRS = [("orchestra", "orchestra"), ("rospy", "rospy"), ("orchestra", "rospy"),
+         ("rospy", "orchestra")]
+SHORT = {"orchestra": "orch", "rospy": "rospy"}
+
+
+def pair_name(pair: tuple[str, str]) -> str:
+    return f"{SHORT[pair[0]]}->{SHORT[pair[1]]}"
+
+
+def round_order(i: int) -> list[tuple[str, str]]:
+    """The pairs in round ``i``'s order: rotated each round, so no pair always runs
+    right after the same one (or first, when the machine is quietest)."""
+    k = i % len(PAIRS)
+    return PAIRS[k:] + PAIRS[:k]
+
+
+def twist100_rounds(env: dict, count: int, rounds: int) -> dict:
+    """Twist at 100 Hz (a robot's cmd_vel), latency only: every pair in each of ``rounds``
+    interleaved rounds. Kept per round (the spread) and pooled per pair (a p99 of one
+    round is its count/100-th worst message: one scheduler hiccup moves it by ms)."""
+    per_round: list[dict] = []
+    pooled: dict[str, list[float]] = {}
+    for i in range(rounds):
+        got = {"load": os.getloadavg()[0]}
+        for pair in round_order(i):
+            samples = bench_topic(env, "twist", count, 0, 0.01, *pair)["samples"]
+            got[pair_name(pair)] = summarize(samples)
+            pooled.setdefault(pair_name(pair), []).extend(samples)
+        per_round.append(got)
+    return {"rounds": per_round, "pooled": {k: summarize(v) for k, v in pooled.items()}}
+
+
+def service_rounds(env: dict, calls: int, persistent_calls: int, rounds: int) -> dict:
+    """Service calls/s of every client->service pair in each of ``rounds`` interleaved
+    rounds (the shared machine's load swings a single run by 2x: medians and the spread)."""
+    per_round: list[dict] = []
+    for i in range(rounds):
+        got = {"load": os.getloadavg()[0]}
+        for cli_impl, svc_impl in round_order(i):
+            got[pair_name((cli_impl, svc_impl))] = bench_service(
+                env, calls, persistent_calls, svc_impl, cli_impl)
+        per_round.append(got)
+    return {"rounds": per_round}
+
+
+def bench_service(env: dict, calls: int, persistent_calls: int, svc_impl: str = "orchestra",
+                  cli_impl: str = "orchestra") -> dict:
+    svc = child(env, "service", impl=svc_impl)
+    try:
+        read(svc, "ready")
+        cli = child(env, "client", "--calls", str(calls), "--persistent-calls",
+                    str(persistent_calls), impl=cli_impl)
+        got = read(cli, "calls_per_s")
+        cli.wait(30)
+        tell(svc)
+        svc.wait(15)
+    finally:
+        for proc in (svc, locals().get("cli")):
+            if proc is not None and proc.poll() is None:
+                proc.kill()
+                proc.wait()
+    return {**got["calls_per_s"], "client_cpu_us": got["client_cpu_us"]}
+
+
+def describe_pinning() -> str:
+    if not CPUS:
+        return "unpinned (placement left to the scheduler)"
+    return (f"pinned: publishers and clients on CPU {CPUS['pub']}, subscribers, services and "
+            f"the master on CPU {CPUS['sub']}")
+
+
+def spread(values: list[float]) -> str:
+    """``median [min-max]`` of per-round ratios."""
+    return f"{statistics.median(values):.2f}x [{min(values):.2f}-{max(values):.2f}]"
+
+
+def print_baseline(results: dict, plan: dict) -> None:
+    """orchestra->orchestra next to the same bytes over a bare socket."""
     print(f"{'':36}{'orchestra':>14}{'raw socket':>14}{'ratio':>9}")
     for kind, label in (("twist", "Twist"), ("image", "Image 640x480")):
         r = results[kind]
@@ -464,58 +571,12 @@ def main() -> None:
         print(f"{'service calls/s ' + key:36}{s[key]:14.0f}{s['baseline']:14.0f}"
               f"{s['baseline'] / s[key]:9.1f}")
     print("ratio = how many times slower than the bare-socket baseline (lower is better)")
-    if "ros1" in results:
-        print_ros1(results, plan)
-    print(results["pinning"])
-    print(load_average())
-
-
-ROUNDS = 5  # interleaved rounds of the service and 100 Hz rows (medians of these)
-SLOW_TWIST_COUNT = 600  # messages per 100 Hz latency run (6 s; --quick: a quarter)
-
-PAIRS = [("orchestra", "orchestra"), ("rospy", "rospy"), ("orchestra", "rospy"),
-         ("rospy", "orchestra")]
-
-
-def bench_service(env: dict, calls: int, svc_impl: str = "orchestra",
-                  cli_impl: str = "orchestra") -> dict:
-    svc = child(env, "service", impl=svc_impl)
-    try:
-        read(svc, "ready")
-        cli = child(env, "client", "--calls", str(calls), impl=cli_impl)
-        result = read(cli, "calls_per_s")["calls_per_s"]
-        cli.wait(30)
-        tell(svc)
-        svc.wait(15)
-    finally:
-        for proc in (svc, locals().get("cli")):
-            if proc is not None and proc.poll() is None:
-                proc.kill()
-                proc.wait()
-    return result
-
-
-def describe_pinning() -> str:
-    if not CPUS:
-        return "unpinned (placement left to the scheduler)"
-    return (f"pinned: publishers and clients on CPU {CPUS['pub']}, subscribers, services and "
-            f"the master on CPU {CPUS['sub']}")
-
-
-def median_of(runs: list[dict], key: str) -> float:
-    return statistics.median(r[key] for r in runs)
-
-
-def load_average() -> str:
-    one, five, fifteen = os.getloadavg()
-    return f"load average {one:.2f} {five:.2f} {fifteen:.2f} on {os.cpu_count()} cores"
 
 
 def print_ros1(results: dict, plan: dict) -> None:
     """orchestra->orchestra next to rospy->rospy and the mixed pairs (pub->sub)."""
-    short = {"orchestra": "orch", "rospy": "rospy"}
-    cols = [f"{short[a]}->{short[b]}" for a, b in PAIRS]
-    print(f"\n{'against real rospy (pub->sub, cli->srv)':36.36}" + "".join(f"{c:>14}" for c in cols)
+    cols = [pair_name(p) for p in PAIRS]
+    print(f"\n{'against real rospy (pub->sub)':36.36}" + "".join(f"{c:>14}" for c in cols)
           + f"{'rospy/orch':>12}")
     for kind, label in (("twist", "Twist"), ("image", "Image 640x480")):
         runs = [results[kind]] + [results["ros1"][f"{kind} {a}->{b}"] for a, b in PAIRS[1:]]
@@ -534,23 +595,53 @@ def print_ros1(results: dict, plan: dict) -> None:
                 ratio = values[1] / values[0] if better_low else values[0] / values[1]
                 line += f"{ratio:11.1f}x"
             print(line)
-    slow = [results["ros1"][f"twist100 {a}->{b}"] for a, b in PAIRS]
-    for key, name in (("median_us", "latency median (us)"), ("p99_us", "latency p99 (us)")):
-        values = [r[key] for r in slow]
-        print(f"{'Twist 100 Hz ' + name:36.36}" + "".join(f"{v:14.0f}" for v in values)
-              + f"{values[1] / values[0]:11.1f}x")
-    p99 = [r["p99_us"] for r in slow]
-    print(f"{'  p99 mixed pairs vs rospy->rospy':36.36}{'':28}{p99[1] / p99[2]:14.1f}x"
-          f"{p99[1] / p99[3]:13.1f}x   (>= 1.0x: no worse than rospy)")
-    svc = [results["ros1"][f"service {a}->{b}"] for a, b in PAIRS]
-    for key in ("plain", "persistent"):
-        values = [median_of(runs, key) for runs in svc]
-        print(f"{'service calls/s ' + key + ', median':36.36}"
-              + "".join(f"{v:14.0f}" for v in values) + f"{values[0] / values[1]:11.1f}x")
-    print(f"(100 Hz rows: {ROUNDS} interleaved rounds pooled, {slow[0]['n']} messages per "
-          f"pair; service rows: medians of {ROUNDS} interleaved rounds)")
     print("rospy/orch = how many times orchestra->orchestra beats rospy->rospy (higher: "
           "orchestra better)")
+
+
+def print_twist100(data: dict) -> None:
+    """The 100 Hz rows: pooled medians and p99s, each round's p99s, and the p99 ratios
+    against rospy->rospy per round (median and range) and pooled."""
+    cols = [pair_name(p) for p in PAIRS]
+    rounds, pooled = data["rounds"], data["pooled"]
+    print(f"\n{'Twist 100 Hz latency (pub->sub)':36.36}" + "".join(f"{c:>14}" for c in cols))
+    for key, name in (("median_us", "median, pooled (us)"), ("p99_us", "p99, pooled (us)")):
+        print(f"{name:36}" + "".join(f"{pooled[c][key]:14.0f}" for c in cols))
+    for i, r in enumerate(rounds, 1):
+        label = f"  p99 round {i} (load {r['load']:.1f})"
+        print(f"{label:36}"
+              + "".join(f"{r[c]['p99_us']:14.0f}" for c in cols))
+    base = "rospy->rospy"
+    print(f"p99 of rospy->rospy / p99 of the pair (>= 1.0x: no worse than rospy; "
+          f"{len(rounds)} rounds of {rounds[0][cols[0]]['n']} messages per pair):")
+    for c in cols:
+        if c == base:
+            continue
+        ratios = [r[base]["p99_us"] / r[c]["p99_us"] for r in rounds]
+        print(f"  {c:14} per round {spread(ratios):24} pooled "
+              f"{pooled[base]['p99_us'] / pooled[c]['p99_us']:.2f}x")
+
+
+def print_services(data: dict) -> None:
+    """Service calls/s per pair: medians of the rounds, each round, and orch->orch over
+    rospy->rospy per round (median and range); the client's CPU per call."""
+    cols = [pair_name(p) for p in PAIRS]
+    rounds = data["rounds"]
+    print(f"\n{'service calls/s (client->service)':36.36}" + "".join(f"{c:>14}" for c in cols))
+    for key in ("plain", "persistent"):
+        print(f"{key + ', median of rounds':36}"
+              + "".join(f"{statistics.median(r[c][key] for r in rounds):14.0f}" for c in cols))
+        for i, r in enumerate(rounds, 1):
+            label = f"  round {i} (load {r['load']:.1f})"
+            print(f"{label:36}"
+                  + "".join(f"{r[c][key]:14.0f}" for c in cols))
+        ratios = [r["orch->orch"][key] / r["rospy->rospy"][key] for r in rounds]
+        print(f"  orch->orch / rospy->rospy per round {spread(ratios)}")
+    for key in ("plain", "persistent"):
+        print(f"{'client CPU per call (us), ' + key:36.36}"
+              + "".join(f"{statistics.median(r[c]['client_cpu_us'][key] for r in rounds):14.1f}"
+                        for c in cols))
+    print(f"({len(rounds)} interleaved rounds, pair order rotated each round)")
 
 
 if __name__ == "__main__":
