@@ -43,7 +43,9 @@ def _run(args: list[str], *, whole_process: bool) -> object:
 
             if whole_process:
                 _short_lived()
-            configure_logging(0)     # what the click group does without -v
+            # what the click group does without -v, when something logs: the modules these
+            # lines run log through log_setup.logger(), so most of them import no logging
+            configure_logging(0, deferred=True)
             run_output_request(request)
             return None
     from orchestra.commands import run

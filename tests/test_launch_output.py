@@ -131,6 +131,7 @@ try:
 except SystemExit as exc:
     code = exc.code
 print("click imported:", "click" in sys.modules, file=sys.stderr)
+print("logging imported:", "logging" in sys.modules, file=sys.stderr)
 sys.exit(code)
 """
 
@@ -163,3 +164,22 @@ def test_both_paths_print_the_same_bytes(tmp_path, mode):
         assert fast.returncode == 0 and fast.stdout.strip()
         # text outside ASCII is printed by click.echo, as on the click path
         assert (b"click imported: False" in fast.stderr) == fast.stdout.isascii()
+
+
+def test_a_warning_is_logged_alike_and_logging_is_imported_only_for_it(tmp_path):
+    """The fast path sets logging up when something is first logged (importing ``logging`` is
+    a tenth of such a process's own work): the warning line is the click path's, and a file
+    that logs nothing imports no logging."""
+    (tmp_path / "quiet.launch").write_text(LAUNCH, encoding="utf-8")
+    (tmp_path / "warns.launch").write_text(LAUNCH.replace("<launch>", "<launch><master/>"),
+                                           encoding="utf-8")
+    quiet = _run(["--nodes", str(tmp_path / "quiet.launch")], through_click=False, cwd=tmp_path)
+    assert quiet.returncode == 0 and b"logging imported: False" in quiet.stderr
+    args = ["--nodes", str(tmp_path / "warns.launch")]
+    fast = _run(args, through_click=False, cwd=tmp_path)
+    slow = _run(args, through_click=True, cwd=tmp_path)
+    warning = f"[WARNING] orchestra.launch.interpreter: {tmp_path / 'warns.launch'}:1: " \
+              "ignoring defunct <master> tag\n"
+    assert fast.stderr.decode().startswith(warning)
+    assert (fast.returncode, fast.stdout, fast.stderr.replace(b"False", b"True")) == \
+        (slow.returncode, slow.stdout, slow.stderr)

@@ -12,7 +12,6 @@ running that command at load time as roslaunch does (unless ``no_exec``).
 from __future__ import annotations
 
 import gc
-import logging
 import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -28,9 +27,10 @@ from orchestra.launch.plan import LaunchPlan, Machine, Node, ParamAction, Test
 from orchestra.launch.rules import LaunchError
 from orchestra.launch.substitution import ArgNotSet, SubstitutionError, resolve
 from orchestra.launch.values import convert_value
+from orchestra.log_setup import logger
 from orchestra.names import canonicalize, is_legal_name, is_private, make_global_ns, ns_join
 
-log = logging.getLogger(__name__)
+log = logger(__name__)
 
 ROSLAUNCH_VERSION = "1.16.0"
 DEFAULT_TIMEOUT = 10.0

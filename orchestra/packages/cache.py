@@ -13,15 +13,15 @@ with HOME unset.
 from __future__ import annotations
 
 import json
-import logging
 import os
 import zlib
 from collections.abc import Mapping
 
 from orchestra import rosdirs
+from orchestra.log_setup import logger
 from orchestra.packages.crawl import Record
 
-log = logging.getLogger(__name__)
+log = logger(__name__)
 
 FORMAT = 2  # 2: package records carry is_metapackage
 

@@ -22,14 +22,15 @@ The crawl reports them separately so the index can say why such a name is not fo
 """
 from __future__ import annotations
 
-import logging
 import os
 import re
 import stat
 import time
 from dataclasses import dataclass, field
 
-log = logging.getLogger(__name__)
+from orchestra.log_setup import logger
+
+log = logger(__name__)
 
 MANIFESTS = ("package.xml", "manifest.xml")
 IGNORE_MARKER = "CATKIN_IGNORE"

@@ -10,7 +10,6 @@ first package found under a name wins and later ones are remembered as shadowed 
 """
 from __future__ import annotations
 
-import logging
 import os
 import time
 from dataclasses import dataclass, field
@@ -26,8 +25,6 @@ from orchestra.packages.discovery import (
     search_roots,
 )
 from orchestra.suggest import did_you_mean
-
-log = logging.getLogger(__name__)
 
 __all__ = ["BUNDLED_PACKAGES", "PackageIndex", "PackageNotFound", "find_package", "get_index",
            "search_path", "reset_index"]

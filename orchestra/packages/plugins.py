@@ -7,14 +7,14 @@ is first scanned as bytes for ``<TOOL`` so only the few packages that can match 
 """
 from __future__ import annotations
 
-import logging
 import os
 from dataclasses import dataclass
 
+from orchestra.log_setup import logger
 from orchestra.packages.index import PackageIndex, get_index
 from orchestra.packages.manifest import InvalidManifest, parse_manifest
 
-log = logging.getLogger(__name__)
+log = logger(__name__)
 
 
 @dataclass(frozen=True)
