@@ -7,15 +7,21 @@ from __future__ import annotations
 
 import os
 import socket
+import sys
 import threading
 import time
 import xmlrpc.client
+from pathlib import Path
 from xmlrpc.server import SimpleXMLRPCServer
 
 import pytest
 
 from orchestra.errors import OrchestraError
 from orchestra.master import master_is_up, start_master, upload_params
+from orchestra.master.notify import Notifier
+
+sys.path.insert(0, str(Path(__file__).resolve().parent / "node_fixtures"))
+from harness import wait_for  # noqa: E402
 
 pytestmark = pytest.mark.timeout(60)
 
@@ -191,6 +197,27 @@ def test_hung_subscriber_blocks_neither_registration_nor_other_nodes(m, slaves):
             ("publisherUpdate", "/master", "/t", [pub.uri])]
     finally:
         hung.close()
+
+
+def _notify_workers() -> set[threading.Thread]:
+    return {t for t in threading.enumerate() if t.name == "master notify"}
+
+
+def test_notifier_reuses_its_waiting_workers_and_close_lets_them_go(slaves):
+    notifier = Notifier()
+    first, second = slaves(), slaves()
+    before = _notify_workers()  # other notifiers' workers, maybe on their way out
+    notifier.send(first.uri, "paramUpdate", "/master", "/a/", 1)
+    assert notifier.wait_idle(5) and first.wait_for(1)
+    mine = _notify_workers() - before
+    assert len(mine) == 1  # drained, and waiting for the next node
+    for value in range(3):
+        notifier.send(second.uri, "paramUpdate", "/master", "/b/", value)
+    assert notifier.wait_idle(5)
+    assert [call[3] for call in second.wait_for(3)] == [0, 1, 2]  # in order
+    assert _notify_workers() - before == mine  # the same worker took the second node
+    notifier.close()
+    wait_for(lambda: not mine & _notify_workers(), timeout=5)
 
 
 def test_lookup_node_returns_slave_api_and_unknown_node_is_error(m, slaves):
