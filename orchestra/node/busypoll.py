@@ -25,6 +25,13 @@ import time
 
 #: longest poll of one wait (ns); a peer that answers later is waited for blocked
 LIMIT_NS = 100_000
+#: one turn of the poll loop (a recv that finds nothing and a yield that finds nobody else
+#: to run) takes a few µs; a turn longer than this means another task had the CPU
+CONTENDED_NS = 30_000
+#: after a poll that lost its CPU, this many waits block, doubling while it recurs (up to
+#: BACKOFF_MAX) and halving with each poll that kept its CPU
+BACKOFF_MIN = 16
+BACKOFF_MAX = 4096
 
 
 def _multi_cpu() -> bool:
@@ -35,35 +42,56 @@ def _multi_cpu() -> bool:
 
 
 class BusyPoll:
-    """The polling decision for one link (a service connection, a proxy's calls): poll the
-    next wait when the last one ended within the limit."""
+    """Polling for one link (a service connection, a proxy's calls): whether to poll the
+    next wait, and the poll itself.
 
-    __slots__ = ("limit_ns", "last_ns")
+    A poll that loses its CPU to another task (the yield, or a preemption, took longer
+    than ``CONTENDED_NS``) is worse than blocking: a thread that blocked is woken and
+    preempts the running task when the answer lands, while one that yielded to a busy CPU
+    waits its turn, a time slice or more (ms). So a contended poll ends there, and the
+    next waits block, ``BACKOFF_MIN`` of them at first, doubling while polls keep losing
+    their CPU: on a busy machine this link behaves as if it never polled."""
+
+    __slots__ = ("limit_ns", "last_ns", "skip", "backoff")
 
     def __init__(self, limit_ns: int = LIMIT_NS):
         self.limit_ns = limit_ns if _multi_cpu() else 0
         self.last_ns = 0  # how long the previous wait took; 0: none yet (poll)
+        self.skip = 0  # waits left to block at once after a contended poll
+        self.backoff = 0  # what ``skip`` was set to the last time
 
     def budget(self) -> int:
         """How long to poll the next wait (ns); 0: block at once."""
+        if self.skip:
+            self.skip -= 1
+            return 0
         return self.limit_ns if self.last_ns < self.limit_ns else 0
 
     def waited(self, start_ns: int) -> None:
         """Record that the wait begun at ``start_ns`` (``time.perf_counter_ns``) is over."""
         self.last_ns = time.perf_counter_ns() - start_ns
 
-
-def poll_recv(sock: socket.socket, size: int, budget_ns: int) -> bytes | None:
-    """Up to ``size`` bytes that arrive on ``sock`` within ``budget_ns``, without blocking;
-    None when nothing came (b"" when the peer closed). ``sock`` must be in blocking mode
-    (no timeout), as connections are once their headers are exchanged."""
-    end = time.perf_counter_ns() + budget_ns
-    recv, flags, clock = sock.recv, socket.MSG_DONTWAIT, time.perf_counter_ns
-    while True:
-        try:
-            return recv(size, flags)
-        except BlockingIOError:
-            if clock() >= end:
+    def recv(self, sock: socket.socket, size: int, budget_ns: int) -> bytes | None:
+        """Up to ``size`` bytes that arrive on ``sock`` within ``budget_ns``, without
+        blocking; None when nothing came (b"" when the peer closed). ``sock`` must be in
+        blocking mode (no timeout), as connections are once their headers are exchanged."""
+        recv, flags, clock = sock.recv, socket.MSG_DONTWAIT, time.perf_counter_ns
+        turn = clock()
+        end = turn + budget_ns
+        while True:
+            try:
+                data = recv(size, flags)
+            except BlockingIOError:
+                data = None
+            last, turn = turn, clock()
+            if turn - last > CONTENDED_NS:
+                self.backoff = min(max(self.backoff * 2, BACKOFF_MIN), BACKOFF_MAX)
+                self.skip = self.backoff
+                return data
+            if data is not None:
+                self.backoff //= 2
+                return data
+            if turn >= end:
                 return None
             _yield_cpu()
 

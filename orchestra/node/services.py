@@ -110,7 +110,7 @@ class ServiceServer:
                         data = reader.message()
                     else:
                         start = time.perf_counter_ns()
-                        reader.poll(poll.budget())
+                        reader.poll(poll)
                         data = reader.message()
                         poll.waited(start)
                 except TransportException:
@@ -203,7 +203,7 @@ class _Connection:
         service answers fast)."""
         tcpros.send_message(self.sock, body)
         start = time.perf_counter_ns()
-        self.reader.poll(poll.budget())
+        self.reader.poll(poll)
         reply = self.reader.service_response()
         poll.waited(start)
         return reply

@@ -169,13 +169,16 @@ class Reader(_Framing):
         self._data = b""
         self._pos = 0
 
-    def poll(self, budget_ns: int) -> None:
-        """When nothing is buffered, poll the socket up to ``budget_ns`` for what comes
-        next (``busypoll``: an answer due within microseconds is read without the thread
-        sleeping); what arrives is buffered for ``exact``."""
-        if budget_ns <= 0 or self._pos < len(self._data):
+    def poll(self, busy: busypoll.BusyPoll) -> None:
+        """When nothing is buffered and ``busy`` says so, poll the socket for what comes
+        next (an answer due within microseconds is read without the thread sleeping);
+        what arrives is buffered for ``exact``."""
+        if self._pos < len(self._data):
             return
-        chunk = busypoll.poll_recv(self.sock, self.CHUNK, budget_ns)
+        budget = busy.budget()
+        if budget <= 0:
+            return
+        chunk = busy.recv(self.sock, self.CHUNK, budget)
         if chunk:  # (b"": the peer closed; the next read finds that out again)
             self._data, self._pos = chunk, 0
 
