@@ -45,10 +45,10 @@ def core():
 
 def test_core_serves_and_sets_roscore_params(core):
     proc, uri = core("-p", "0")
-    m = xmlrpc.client.ServerProxy(uri)
-    assert m.getPid("/t") == [1, "", proc.pid]
-    assert m.getUri("/t")[2] == uri
-    params = m.getParam("/t", "/")[2]
+    with xmlrpc.client.ServerProxy(uri) as m:
+        assert m.getPid("/t") == [1, "", proc.pid]
+        assert m.getUri("/t")[2] == uri
+        params = m.getParam("/t", "/")[2]
     assert params["rosdistro"].endswith("\n") and params["rosversion"].endswith("\n")
     assert len(params["run_id"]) == 36  # a uuid, as roslaunch writes it
 
@@ -62,7 +62,8 @@ def test_core_stops_cleanly_on_sigint(core):
 
 def test_core_stops_on_xmlrpc_shutdown(core):
     proc, uri = core("-p", "0")
-    assert xmlrpc.client.ServerProxy(uri).shutdown("/t", "test")[0] == 1
+    with xmlrpc.client.ServerProxy(uri) as m:
+        assert m.shutdown("/t", "test")[0] == 1
     assert proc.wait(10) == 0
 
 

@@ -11,6 +11,7 @@ import shutil
 import stat
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 from catkin_pkg.package import parse_package
@@ -167,14 +168,14 @@ def test_python_node_option_writes_executable_node_and_launch_file(tmp_path):
     node = os.path.join(created.path, "scripts", "talker")
     launch = os.path.join(created.path, "launch", "talker_pkg.launch")
     assert os.stat(node).st_mode & stat.S_IXUSR
-    source = open(node).read()
+    source = Path(node).read_text()
     compile(source, node, "exec")
     assert "import orchestra.node as on" in source and 'get_message_class("std_msgs/String")' in source
     from lxml import etree
     node_el = etree.parse(launch).getroot().find("node")
     assert (node_el.get("pkg"), node_el.get("type"), node_el.get("name")) == (
         "talker_pkg", "talker", "talker")
-    cmake = open(os.path.join(created.path, "CMakeLists.txt")).read()
+    cmake = Path(created.path, "CMakeLists.txt").read_text()
     assert "catkin_install_python(PROGRAMS scripts/talker" in cmake
 
 

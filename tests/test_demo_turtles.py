@@ -65,6 +65,9 @@ class Observer:
             except subprocess.TimeoutExpired:
                 self.proc.kill()
                 self.proc.wait()
+        self.reader.join(10)         # it reads up to the end of the pipe, then we close it
+        if not self.reader.is_alive():
+            self.proc.stdout.close()
 
 
 class Launch:

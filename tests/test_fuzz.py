@@ -347,7 +347,8 @@ def test_master_answers_malformed_xmlrpc_bodies_and_keeps_serving(master_uri, ca
         _count("master-xmlrpc", "traceback", time.monotonic() - start)
     assert ok, (response.status, answer[:500])
     # still serving, and nothing dumped on the console by the server thread
-    code, _, pid = xmlrpc.client.ServerProxy(master_uri).getPid("/fuzz")
+    with xmlrpc.client.ServerProxy(master_uri) as proxy:
+        code, _, pid = proxy.getPid("/fuzz")
     assert code == 1 and pid == os.getpid()
     printed = capfd.readouterr().err
     if "Traceback" in printed:

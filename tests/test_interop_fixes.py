@@ -79,8 +79,8 @@ class _RospyLikeSlave:
 
 
 def _register(master, slave: _RospyLikeSlave) -> None:
-    proxy = xmlrpc.client.ServerProxy(master.uri)
-    assert proxy.registerPublisher("/victim", "/t", "std_msgs/String", slave.uri)[0] == 1
+    with xmlrpc.client.ServerProxy(master.uri) as proxy:
+        assert proxy.registerPublisher("/victim", "/t", "std_msgs/String", slave.uri)[0] == 1
 
 
 def test_kill_counts_a_node_that_drops_the_reply_and_goes_silent_as_killed(master):
@@ -112,8 +112,8 @@ def test_kill_of_a_node_that_no_longer_answers_names_it(master):
     with socket.socket() as sock:
         sock.bind(("127.0.0.1", 0))
         dead_uri = f"http://127.0.0.1:{sock.getsockname()[1]}/"
-    proxy = xmlrpc.client.ServerProxy(master.uri)
-    proxy.registerPublisher("/ghost", "/t", "std_msgs/String", dead_uri)
+    with xmlrpc.client.ServerProxy(master.uri) as proxy:
+        proxy.registerPublisher("/ghost", "/t", "std_msgs/String", dead_uri)
     with pytest.raises(introspect.GraphError, match=r"node \[/ghost\] does not answer"):
         introspect.kill_node(master.uri, "/ghost")
 
@@ -145,9 +145,9 @@ def test_node_info_names_inbound_peers_and_shows_rospy_socket_text_like_rosnode(
         [2, "/gone", "i", "TCPROS", "/t", False, ""],
         [3, "/late", "o", "TCPROS", "/t", True]]})
     try:
-        proxy = xmlrpc.client.ServerProxy(master.uri)
-        proxy.registerPublisher("/talker", "/t", "std_msgs/String", publisher.uri)
-        proxy.registerSubscriber("/listener", "/t", "std_msgs/String", listener.uri)
+        with xmlrpc.client.ServerProxy(master.uri) as proxy:
+            proxy.registerPublisher("/talker", "/t", "std_msgs/String", publisher.uri)
+            proxy.registerSubscriber("/listener", "/t", "std_msgs/String", listener.uri)
         monkeypatch.setenv("ROS_MASTER_URI", master.uri)
         with pytest.raises(SystemExit) as info:
             main(["node", "info", "/listener"])
@@ -198,7 +198,10 @@ import orchestra.node as rospy
 rospy.init_node("leaver")
 from orchestra.node.msg import get_message_class
 rospy.Publisher("chatter", get_message_class("std_msgs/String"))
-rospy.on_shutdown(lambda: time.sleep(1.0))   # a slow hook: the exit takes a while
+def slow_hook():                              # a slow hook: the exit takes a while
+    print(json.dumps({"hook": True}), flush=True)
+    time.sleep(1.0)
+rospy.on_shutdown(slow_hook)
 print(json.dumps({"ready": True}), flush=True)
 sys.stdin.readline()                          # the script ends when the test says so
 print(json.dumps({"ending": True}), flush=True)
@@ -211,28 +214,27 @@ def test_sigint_while_a_finished_script_unregisters_does_not_leave_it_registered
     import signal
     import subprocess
     import sys
-    import time
 
     script = tmp_path / "leaver.py"
     script.write_text(EXITING_NODE)
     env = dict(os.environ, ROS_MASTER_URI=master.uri, PYTHONUNBUFFERED="1")
-    proc = subprocess.Popen([sys.executable, str(script)], env=env, stdin=subprocess.PIPE,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    try:
-        assert "ready" in proc.stdout.readline()
-        proc.stdin.write("\n")
-        proc.stdin.flush()
-        assert "ending" in proc.stdout.readline()
-        time.sleep(0.3)  # inside the slow hook, at interpreter exit
-        proc.send_signal(signal.SIGINT)
-        proc.send_signal(signal.SIGINT)
-        assert proc.wait(10) == 0, proc.stderr.read()
-        pubs = xmlrpc.client.ServerProxy(master.uri).getSystemState("/probe")[2][0]
-        assert not [t for t, nodes in pubs if "/leaver" in nodes]
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
+    with subprocess.Popen([sys.executable, str(script)], env=env, stdin=subprocess.PIPE,
+                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as proc:
+        try:
+            assert "ready" in proc.stdout.readline()
+            proc.stdin.write("\n")
+            proc.stdin.flush()
+            assert "ending" in proc.stdout.readline()
+            assert "hook" in proc.stdout.readline()     # inside the slow hook, at exit
+            proc.send_signal(signal.SIGINT)
+            proc.send_signal(signal.SIGINT)
+            assert proc.wait(10) == 0, proc.stderr.read()
+            with xmlrpc.client.ServerProxy(master.uri) as proxy:
+                pubs = proxy.getSystemState("/probe")[2][0]
+            assert not [t for t, nodes in pubs if "/leaver" in nodes]
+        finally:
+            if proc.poll() is None:
+                proc.kill()
 
 
 def test_bus_info_describes_the_socket_as_rospy_does():

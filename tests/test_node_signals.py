@@ -62,7 +62,8 @@ def test_a_tools_second_sigint_does_not_interrupt_the_first_ones_unwinding():
 
 
 def _chatter_published(uri: str) -> bool:
-    publishers = xmlrpc.client.ServerProxy(uri).getSystemState("/probe")[2][0]
+    with xmlrpc.client.ServerProxy(uri) as master:
+        publishers = master.getSystemState("/probe")[2][0]
     return any(topic == "/chatter" for topic, _ in publishers)
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 import json
 import os
 import time
+from pathlib import Path
 
 import pytest
 
@@ -134,7 +135,7 @@ def test_ros_package_path_shadows_bundled_package(monkeypatch, tmp_path):
              if os.path.isfile(os.path.join(BUNDLED_PACKAGES, d, "package.xml"))]
     bundled_name = None
     for d in names:
-        text = open(os.path.join(BUNDLED_PACKAGES, d, "package.xml")).read()
+        text = Path(BUNDLED_PACKAGES, d, "package.xml").read_text()
         if f"<name>{d}</name>" in text:
             bundled_name = d
             break

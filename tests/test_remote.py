@@ -182,8 +182,11 @@ def test_agent_runs_the_node_through_the_client_and_stops_it_when_the_client_die
         wait_for(lambda: b"got SIGINT" in log.read_bytes())     # the node stopped in order,
         assert log.read_bytes().startswith(b"up\n")             # ...its output kept there
     finally:
+        client.kill()
+        client.communicate()
         agent_proc.stdout.close()                               # the agent's session ends
         assert agent_proc.wait(timeout=10) == 0
+        agent_proc.stderr.close()
     assert not os.path.exists(os.path.dirname(sock))
 
 
@@ -227,12 +230,14 @@ def test_node_exit_status_reaches_the_client(package):
     finally:
         agent_proc.stdout.close()
         agent_proc.wait(timeout=10)
+        agent_proc.stderr.close()
 
 
 def test_agent_reports_missing_executables_before_anything_runs(package):
     proc, report, _ = start_agent([Node("adem", "stopper", "a"),
                                    Node("adem", "nothere", "b", filename="f", line=2)], package)
-    assert proc.wait(timeout=10) == 0
+    proc.communicate(timeout=10)
+    assert proc.returncode == 0
     assert len(report["missing"]) == 1 and "nothere" in report["missing"][0]
 
 

@@ -205,7 +205,8 @@ def test_wait_flag_waits_for_an_external_master_and_uses_it(launch_env):
         assert list(launch_env["pids"].iterdir()) == []      # nothing started meanwhile
         master = start_master("127.0.0.1", port_from_uri(launch_env["env"]["ROS_MASTER_URI"]))
         pids = wait_pids(launch_env, proc)
-        code, _, run_id = xmlrpc.client.ServerProxy(master.uri).getParam("/t", "/run_id")
+        with xmlrpc.client.ServerProxy(master.uri) as proxy:
+            code, _, run_id = proxy.getParam("/t", "/run_id")
         assert code == 1 and run_id
         proc.send_signal(signal.SIGINT)
         out, err = proc.communicate(timeout=30)

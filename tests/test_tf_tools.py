@@ -111,6 +111,8 @@ def master():
 def test_static_transform_reaches_tf_echo_and_view_frames(master, tmp_path):
     env = dict(BUNDLED_ENV, ROS_MASTER_URI=master, PYTHONUNBUFFERED="1")
     procs = []
+    readers: list[threading.Thread] = []
+    echo_err = open(tmp_path / "tf_echo.err", "w+")
     try:
         procs.append(subprocess.Popen(
             [str(SCRIPTS / "static_transform_publisher"), "1", "2", "0", "1.5707963", "0", "0",
@@ -119,7 +121,6 @@ def test_static_transform_reaches_tf_echo_and_view_frames(master, tmp_path):
             [str(SCRIPTS / "static_transform_publisher"), "0", "0", "0", "0", "0", "0", "1",
              "odom", "base_link", "20"], env=env, stdout=subprocess.DEVNULL,
             stderr=subprocess.DEVNULL))
-        echo_err = open(tmp_path / "tf_echo.err", "w+")
         echo = subprocess.Popen([str(SCRIPTS / "tf_echo"), "odom", "laser", "10"], env=env,
                                 stdout=subprocess.PIPE, stderr=echo_err, text=True)
         procs.append(echo)
@@ -132,7 +133,9 @@ def test_static_transform_reaches_tf_echo_and_view_frames(master, tmp_path):
                 if line.startswith("            in RPY (degree)"):
                     complete.set()
                     return
-        threading.Thread(target=read_echo, daemon=True).start()
+        reader = threading.Thread(target=read_echo, daemon=True)
+        readers.append(reader)
+        reader.start()
         view = subprocess.run([str(SCRIPTS / "view_frames"), "2", str(tmp_path / "frames")],
                               env=env, capture_output=True, text=True, timeout=40)
         assert view.returncode == 0, view.stderr
@@ -157,3 +160,9 @@ def test_static_transform_reaches_tf_echo_and_view_frames(master, tmp_path):
             except subprocess.TimeoutExpired:
                 p.kill()
                 p.wait()
+        echo_err.close()
+        for reader in readers:          # up to the end of the pipe (or the line it wanted)
+            reader.join(10)
+        for p in procs:
+            if p.stdout is not None:
+                p.stdout.close()
