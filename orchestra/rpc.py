@@ -299,10 +299,8 @@ class AnyPathHandler(socketserver.BaseRequestHandler):
                 buffer = buffer.lstrip(b"\r\n")
                 scanned = 0
             head_end, body_start = _head_end(buffer, scanned)
-            if head_end >= 0:
+            if head_end >= 0 or len(buffer) > MAX_HEAD:
                 break
-            if len(buffer) > MAX_HEAD:
-                return self._refuse(414 if buffer.find(b"\n", 0, MAX_LINE + 1) < 0 else 431)
             scanned = max(0, len(buffer) - 2)  # the end marker may straddle two reads
             chunk = recv(_RECV)
             if not chunk:
@@ -313,7 +311,7 @@ class AnyPathHandler(socketserver.BaseRequestHandler):
                 if type(buffer) is bytes:
                     buffer = bytearray(buffer)
                 buffer += chunk
-        if head_end > MAX_HEAD:
+        if not 0 <= head_end <= MAX_HEAD:  # the request line, or the whole head, too long
             return self._refuse(414 if buffer.find(b"\n", 0, MAX_LINE + 1) < 0 else 431)
         data = buffer if isinstance(buffer, bytes) else bytes(buffer)
         lines = data[:head_end].split(b"\n")

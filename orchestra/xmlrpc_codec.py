@@ -112,6 +112,7 @@ def _flat_call(params: int) -> re.Pattern[str]:
         + "[ \t\n]*</params>[ \t\n]*</methodCall>")
 
 
+# up to 8 params (the Master API's longest call has 4); longer calls take the walk below
 _FLAT_CALLS = [_flat_call(params) for params in range(9)]
 _T = _TOKEN.groupindex
 _TYPE, _TYPED, _UNTYPED, _NIL = _T["type"], _T["typed"], _T["untyped"], _T["nil"]
