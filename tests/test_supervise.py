@@ -10,6 +10,7 @@ import signal
 import subprocess
 import sys
 import textwrap
+import threading
 import time
 from pathlib import Path
 
@@ -435,6 +436,23 @@ def test_spawner_gives_outcomes_in_call_order_with_errors_as_outcomes():
     assert [o.value for o in outcomes] == [1, None, 3, 4, 5]
     assert isinstance(outcomes[1].error, OSError)
     assert [o.error for o in outcomes if o is not outcomes[1]] == [None] * 4
+
+
+def test_spawner_runs_the_calls_itself_when_no_thread_can_start(monkeypatch):
+    """RLIMIT_NPROC reached: the work already queued is done in the caller's thread."""
+    from orchestra.supervise import spawner as spawner_module
+
+    class NoThread(threading.Thread):
+        def start(self) -> None:
+            raise RuntimeError("can't start new thread")
+
+    monkeypatch.setattr(spawner_module.threading, "Thread", NoThread)
+    spawner = spawner_module.Spawner(max_threads=4)
+    try:
+        outcomes = spawner.run([threading.get_ident for _ in range(3)])
+    finally:
+        spawner.close()
+    assert [o.value for o in outcomes] == [threading.get_ident()] * 3
 
 
 @pytest.mark.skipif(not setpriv_prefix(), reason="util-linux setpriv --pdeathsig not available")
