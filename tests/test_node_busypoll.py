@@ -76,3 +76,23 @@ def test_reader_poll_keeps_what_it_read_for_the_framed_reads_after_it():
         a.sendall(struct.pack("<I", 3) + b"abc")
         reader.poll(BusyPoll(limit_ns=0))  # no budget: the read below blocks as before
         assert reader.message() == b"abc"
+
+
+def test_the_backoff_halves_only_after_a_streak_of_polls_that_kept_their_cpu(monkeypatch):
+    a, b = socket.socketpair()
+    ticks = iter(range(0, 1 << 60, busypoll.CONTENDED_NS + 1))
+    monkeypatch.setattr(busypoll.time, "perf_counter_ns", lambda: next(ticks))
+    with a, b:
+        poll = BusyPoll(limit_ns=1 << 50)
+        poll.recv(b, 100, 1 << 50)  # contended: BACKOFF_MIN waits block
+        poll.recv(b, 100, 1 << 50)  # again: twice that
+        assert poll.backoff == 2 * busypoll.BACKOFF_MIN
+        quick = iter(range(1 << 60))
+        monkeypatch.setattr(busypoll.time, "perf_counter_ns", lambda: next(quick))
+        for _ in range(busypoll.STREAK - 1):
+            a.sendall(b"x")
+            assert poll.recv(b, 100, 1 << 50) == b"x"
+        assert poll.backoff == 2 * busypoll.BACKOFF_MIN  # one lucky poll changes nothing
+        a.sendall(b"x")
+        poll.recv(b, 100, 1 << 50)
+        assert poll.backoff == busypoll.BACKOFF_MIN

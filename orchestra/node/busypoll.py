@@ -29,9 +29,10 @@ LIMIT_NS = 100_000
 #: to run) takes a few µs; a turn longer than this means another task had the CPU
 CONTENDED_NS = 30_000
 #: after a poll that lost its CPU, this many waits block, doubling while it recurs (up to
-#: BACKOFF_MAX) and halving with each poll that kept its CPU
+#: BACKOFF_MAX) and halving after each STREAK polls in a row that kept their CPU
 BACKOFF_MIN = 16
 BACKOFF_MAX = 4096
+STREAK = 64
 
 
 def _multi_cpu() -> bool:
@@ -50,15 +51,19 @@ class BusyPoll:
     preempts the running task when the answer lands, while one that yielded to a busy CPU
     waits its turn, a time slice or more (ms). So a contended poll ends there, and the
     next waits block, ``BACKOFF_MIN`` of them at first, doubling while polls keep losing
-    their CPU: on a busy machine this link behaves as if it never polled."""
+    their CPU: on a busy machine this link behaves as if it never polled (one poll per
+    ``BACKOFF_MAX`` waits, a lost slice of a few ms per ~4,096 calls). The backoff halves only
+    after ``STREAK`` polls in a row kept their CPU, so the few lucky polls of a busy
+    machine do not bring the costly ones back."""
 
-    __slots__ = ("limit_ns", "last_ns", "skip", "backoff")
+    __slots__ = ("limit_ns", "last_ns", "skip", "backoff", "streak")
 
     def __init__(self, limit_ns: int = LIMIT_NS):
         self.limit_ns = limit_ns if _multi_cpu() else 0
         self.last_ns = 0  # how long the previous wait took; 0: none yet (poll)
         self.skip = 0  # waits left to block at once after a contended poll
         self.backoff = 0  # what ``skip`` was set to the last time
+        self.streak = 0  # polls in a row that kept their CPU
 
     def budget(self) -> int:
         """How long to poll the next wait (ns); 0: block at once."""
@@ -86,10 +91,13 @@ class BusyPoll:
             last, turn = turn, clock()
             if turn - last > CONTENDED_NS:
                 self.backoff = min(max(self.backoff * 2, BACKOFF_MIN), BACKOFF_MAX)
-                self.skip = self.backoff
+                self.skip, self.streak = self.backoff, 0
                 return data
             if data is not None:
-                self.backoff //= 2
+                self.streak += 1
+                if self.streak >= STREAK:
+                    self.backoff //= 2
+                    self.streak = 0
                 return data
             if turn >= end:
                 return None
