@@ -75,7 +75,8 @@ def complete_launch_words(ctx: click.Context, param: click.Parameter,
         path = _launch_file(words)
         if path is None:
             return []
-        from orchestra.launch.interpreter import declared_args, parse_launch_file
+        from orchestra.launch.declared_args import declared_args
+        from orchestra.launch.interpreter import parse_launch_file
 
         given = {w.split(":=", 1)[0] for w in words if ":=" in w}
         return [CompletionItem(f"{a.name}:=", help=a.doc or None)

@@ -9,7 +9,7 @@ import pytest
 
 from orchestra.errors import OrchestraError
 from orchestra.launch import rules
-from orchestra.launch.check import check_files
+from orchestra.launch.check import Finding, check_files
 from orchestra.launch.entity import Entity
 from orchestra.launch.interpreter import Interpreter, LoadOptions
 from orchestra.launch.rules import LaunchError
@@ -42,7 +42,7 @@ class _Recording(Interpreter):
 
     def __init__(self) -> None:
         super().__init__(LoadOptions(no_exec=True))
-        self.findings: list[rules.Finding] = []
+        self.findings: list[Finding] = []
         self.errors: list[OrchestraError] = []
 
     def _children(self, children, scope, default_machine):
@@ -55,7 +55,7 @@ class _Recording(Interpreter):
 
     def _warn(self, entity: Entity, message: str, code: str = rules.INVALID,
               attribute: str | None = None) -> None:
-        self.findings.append(rules.Finding(entity.location, message, code, entity.tag,
+        self.findings.append(Finding(entity.location, message, code, entity.tag,
                                            attribute))
 
 

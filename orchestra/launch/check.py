@@ -582,6 +582,20 @@ class Checker:
                 seen[node.full_name] = node
 
 
+@dataclass(frozen=True)
+class Finding:
+    """A non-fatal problem the interpreter met (it goes on, as roslaunch does). Here, not
+    with the tag rules: only ``orchestra check`` keeps them as values, and every launch
+    process would otherwise build the class (~5 M instructions)."""
+
+    location: Location
+    message: str
+    code: str
+    tag: str | None = None
+    attribute: str | None = None
+    exact: Location | None = field(default=None, compare=False)
+
+
 class _CollectingInterpreter(Interpreter):
     """The real interpreter, except that an error skips one element instead of the run.
 
@@ -593,7 +607,7 @@ class _CollectingInterpreter(Interpreter):
     def __init__(self, options: LoadOptions):
         super().__init__(options)
         self.errors: list[OrchestraError] = []
-        self.findings: list[rules.Finding] = []
+        self.findings: list[Finding] = []
 
     def _children(self, children: list[Entity], scope: Scope,
                   default_machine: Machine | None) -> Machine | None:
@@ -606,7 +620,7 @@ class _CollectingInterpreter(Interpreter):
 
     def _warn(self, entity: Entity, message: str, code: str = rules.INVALID,
               attribute: str | None = None) -> None:
-        self.findings.append(rules.Finding(entity.location, message, code, entity.tag,
+        self.findings.append(Finding(entity.location, message, code, entity.tag,
                                            attribute, entity.where(attribute)))
         self.warnings.append(f"{entity.location}: {message}")
 

@@ -36,8 +36,8 @@ ROSLAUNCH_VERSION = "1.16.0"
 DEFAULT_TIMEOUT = 10.0
 TEST_TIME_LIMIT = 60.0
 
-__all__ = ["ArgInfo", "Binary", "Interpreter", "LaunchError", "LoadOptions", "binary_to_json",
-           "declared_args", "load_launch", "parse_launch_file"]
+__all__ = ["Binary", "Interpreter", "LaunchError", "LoadOptions", "binary_to_json", "load_launch",
+           "parse_launch_file"]
 
 # where a <param>'s value comes from: exactly one is written
 _PARAM_SOURCES = ("value", "textfile", "binfile", "command")
@@ -69,15 +69,6 @@ def _resume_collector(paused: bool) -> None:
 
 class Binary(bytes):
     """A ``binfile`` / ``!!binary`` value (bytes; XML-RPC base64 on the wire)."""
-
-
-@dataclass(frozen=True)
-class ArgInfo:
-    """A top-level ``<arg>`` as ``--ros-args`` reports it."""
-
-    name: str
-    doc: str | None
-    default: str | None
 
 
 @dataclass
@@ -777,37 +768,6 @@ _TAGS: dict[str, Callable[..., Any]] = {
     "arg": Interpreter._arg,
 }
 assert sorted(_TAGS) == sorted(rules.SCOPE_CHILDREN), "rules.SCOPE_CHILDREN is what dispatches"
-
-
-def declared_args(root: Entity, filename: str, args: dict[str, str] | None = None
-                  ) -> list[ArgInfo]:
-    """The top-level ``<arg>``s of a launch file without interpreting it (``--ros-args``).
-
-    Like roslaunch's args-only mode this must work when required args are missing, so a
-    substitution that cannot be resolved is shown as written.
-    """
-    scope = Scope(os.environ.get("ROS_NAMESPACE", "/") or "/", filename)
-    scope.args = dict(args or {})
-    found: list[ArgInfo] = []
-    for entity in root.children:
-        if entity.tag != "arg" or "name" not in entity.attributes:
-            continue
-        values: dict[str, str | None] = {}
-        for attr in ("name", "value", "default", "doc"):
-            raw = entity.attributes.get(attr)
-            try:
-                values[attr] = resolve(raw, scope)
-            except OrchestraError:
-                values[attr] = raw
-        name = values["name"] or ""  # written (checked above), so resolved to a string
-        if values["value"] is not None:
-            scope.args.setdefault(name, values["value"])
-            if values["value"]:
-                continue
-        elif values["default"] is not None:
-            scope.args.setdefault(name, values["default"])
-        found.append(ArgInfo(name, values["doc"], values["default"]))
-    return found
 
 
 def load_launch(path: str, args: dict[str, str] | None = None, *, no_exec: bool = False,

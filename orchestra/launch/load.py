@@ -141,8 +141,8 @@ def undeclared_args(paths: list[str], args: dict[str, str]) -> list[str]:
 
 
 def ros_args_text(paths: list[str], args: dict[str, str]) -> str:
+    from orchestra.launch.declared_args import declared_args
     from orchestra.launch.frontends import parse_file, parse_string
-    from orchestra.launch.interpreter import declared_args
     declared = []
     for path in paths:
         if path == "-":

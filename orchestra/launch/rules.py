@@ -13,7 +13,7 @@ Adding an attribute is one line in ``TAGS`` (its kind, whether it is required).
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import cached_property, lru_cache
 from types import MappingProxyType
 
@@ -291,15 +291,3 @@ class LaunchError(OrchestraError):
         self.attribute = attribute
         self.code = code
         self.exact = exact if exact is not None else location
-
-
-@dataclass(frozen=True)
-class Finding:
-    """A non-fatal problem the interpreter met (it goes on, as roslaunch does)."""
-
-    location: Location
-    message: str
-    code: str
-    tag: str | None = None
-    attribute: str | None = None
-    exact: Location | None = field(default=None, compare=False)
