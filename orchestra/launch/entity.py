@@ -6,7 +6,6 @@ values stay the raw strings written in the file (substitutions unresolved) so th
 """
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Protocol
 
@@ -21,20 +20,6 @@ class SourcePositions(Protocol):
     def start(self, entity: Entity) -> Location: ...
 
     def attribute(self, entity: Entity, name: str) -> Location | None: ...
-
-
-@dataclass(frozen=True)
-class KnownPositions:
-    """Positions a front end had at hand while reading (YAML marks)."""
-
-    start_at: Location
-    attributes: Mapping[str, Location]
-
-    def start(self, entity: Entity) -> Location:
-        return self.start_at
-
-    def attribute(self, entity: Entity, name: str) -> Location | None:
-        return self.attributes.get(name)
 
 
 @dataclass(slots=True)

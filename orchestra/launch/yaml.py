@@ -28,13 +28,33 @@ refused outright.
 """
 from __future__ import annotations
 
+from collections.abc import Mapping
+from dataclasses import dataclass
+
 import yaml as pyyaml
 from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 
 from orchestra.errors import Location, OrchestraError, offset_location
-from orchestra.launch.entity import Entity, KnownPositions
+from orchestra.launch.entity import Entity
 from orchestra.params.yaml import char_name as _char_name
 from orchestra.params.yaml import reader_error_location
+
+
+@dataclass(frozen=True)
+class KnownPositions:
+    """Positions this front end had at hand while reading (YAML marks): the
+    ``entity.SourcePositions`` of a YAML element. (Here, not in entity.py: only YAML files
+    need the class, and every launch process would otherwise build it, ~5 M instructions.)"""
+
+    start_at: Location
+    attributes: Mapping[str, Location]
+
+    def start(self, entity: Entity) -> Location:
+        return self.start_at
+
+    def attribute(self, entity: Entity, name: str) -> Location | None:
+        return self.attributes.get(name)
+
 
 # The element key holding the element's own text (inline rosparam YAML).
 TEXT_KEY = "text"
