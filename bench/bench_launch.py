@@ -155,7 +155,7 @@ def _orchestra_env(env: dict) -> dict:
 def _without_site_hooks(env: dict) -> tuple[list[str], dict]:
     """argv prefix and ``env`` of orchestra run by ``python -S`` with site-packages on
     PYTHONPATH: the same code and dependencies without this interpreter's ``.pth`` start-up
-    hooks (pip's editable-install finder, a certificate hook of the machine) that every
+    hooks (this machine's certificate hook, which imports certifi and importlib.resources) that every
     ``python`` here runs first and Debian's python3, which runs roslaunch, does not: about
     what a plain ``pip install`` in a virtualenv gives (which keeps site's own ~2 ms)."""
     import site
@@ -329,7 +329,7 @@ def bench_startup(samples: int, rows: list) -> None:
                 cpus[what].append(cpu)
     base = statistics.median(times["python -c pass"])
     print(f"start-up: python -c pass {base * 1e3:.0f} ms, of which this interpreter's site "
-          "start-up (its .pth hooks: the editable-install finder, ...) "
+          "start-up (its .pth hooks, e.g. a certificate hook) "
           f"{(base - statistics.median(times['python -S -c pass'])) * 1e3:.0f} ms")
     base_cpu = statistics.median(cpus["python -c pass"])
     for what in list(runs)[2:]:
