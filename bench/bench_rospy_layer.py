@@ -44,6 +44,10 @@ def layer_env(master_uri: str) -> dict[str, str]:
 
     env = dict(os.environ, ROS_MASTER_URI=master_uri, PYTHONPATH=REPO)
     env.pop("ROS_NAMESPACE", None)
+    # Debian's rospy runs from byte-compiled files; with PYTHONDONTWRITEBYTECODE inherited
+    # (some shells set it) the layer side compiled its modules in every process (~30 ms of
+    # a ~90 ms exec->init_node: 0.80x instead of 0.37x)
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
     env.update(activation_env(env))
     return env
 
