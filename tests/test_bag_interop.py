@@ -102,12 +102,17 @@ def _state(uri: str) -> tuple[dict, dict]:
 
 def test_bag_recorded_by_orchestra_is_read_by_real_rosbag(peers, tmp_path):
     out = tmp_path / "mixed.bag"
+    # the talkers first (they publish once subscribed): real rospy's Publisher registers
+    # before it enables its latch, so a recorder already waiting could connect in between
+    # and be told latching=0 (a rospy race, seen under load); "ready" comes after both
+    talkers = [peers.script("burst.py", "/talk", "200", "200", "--latch", "--name",
+                            "rospy_talker", real=True),
+               peers.script("burst.py", "/orch", "200", "200", "--name", "orch_talker",
+                            real=False)]
+    for talker in talkers:
+        talker.expect(lambda d: "ready" in d, timeout=30)
     rec = peers.orchestra("bag", "record", "-q", "--lz4", "-O", str(out), "--limit", "200",
                           "/talk", "/orch")
-    wait_for(lambda: {"/talk", "/orch"} <= set(_state(peers.uri)[1]), timeout=20)
-    peers.script("burst.py", "/talk", "200", "200", "--latch", "--name", "rospy_talker",
-                 real=True)
-    peers.script("burst.py", "/orch", "200", "200", "--name", "orch_talker", real=False)
     assert rec.wait(timeout=60) == 0, rec.stderr_lines
     dump = peers.ros_python("""
         import json, sys, rosbag

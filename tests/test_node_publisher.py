@@ -53,3 +53,21 @@ def test_a_small_message_on_an_idle_connection_is_sent_by_publish_itself():
     finally:
         conn.close()
         theirs.close()
+
+
+def test_a_subscriber_joins_before_it_can_read_our_header_so_no_message_falls_between():
+    """The subscriber counts itself connected once it has our header (actionlib's
+    wait_for_server does): a message published from then on must reach it, so the
+    connection is in the publication before the header goes out, and the header first."""
+    pub = Publication(None, "/t", STRING, False, None)
+    ours, theirs = socket.socketpair()
+    conn = pub.add_connection(ours, {"callerid": "/sub"},
+                              tcpros.encode_header({"callerid": "/pub", "topic": "/t"}))
+    try:
+        assert conn in pub.connections
+        pub.publish(STRING(data="first"))   # before the writer has sent the header, even
+        assert tcpros.read_header(theirs) == {"callerid": "/pub", "topic": "/t"}
+        assert tcpros.read_message(theirs) == STRING(data="first").serialize_bytes()
+    finally:
+        conn.close()
+        theirs.close()

@@ -218,8 +218,11 @@ class Publication:
         for conn in conns:
             conn.enqueue(data)
 
-    def add_connection(self, sock: socket.socket, header: dict[str, str]) -> OutConnection:
+    def add_connection(self, sock: socket.socket, header: dict[str, str],
+                       reply: bytes | None = None) -> OutConnection:
+        """A subscriber's connection; ``reply`` (our header) is the first thing it is sent."""
         conn = OutConnection(self, sock, header.get("callerid", "?"), self.queue_size)
+        conn.rest = reply
         with self.lock:
             if self.latched is not None:
                 conn.queue.append(self.latched)
@@ -722,10 +725,14 @@ class TopicManager:
                                 f"[{header.get('type')}/{their_md5}], but our version has "
                                 f"[{cls._type}/{cls._md5sum}]. Dropping connection.")
             return
-        tcpros.write_header(sock, {
+        # the connection joins the publication first and its writer sends this header before
+        # anything else: once the subscriber has read it, every later publish reaches it.
+        # Written here and then added (as rospy does), a message published in between was
+        # lost to a subscriber that already counted itself connected (actionlib's
+        # wait_for_server, then the server's first feedback).
+        pub.add_connection(sock, header, tcpros.encode_header({
             "callerid": self.rt.name, "topic": topic, "md5sum": cls._md5sum, "type": cls._type,
-            "message_definition": cls._full_text, "latching": "1" if pub.latch else "0"})
-        pub.add_connection(sock, header)
+            "message_definition": cls._full_text, "latching": "1" if pub.latch else "0"}))
 
     def close_all(self) -> None:
         with self.lock:
