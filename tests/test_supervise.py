@@ -396,6 +396,45 @@ def test_sigkilled_orchestra_leaves_no_orphan(tmp_path, pdeathsig, with_watchdog
                 os.kill(pid, signal.SIGKILL)
 
 
+SLOW_SPAWN = """
+import os, sys, time
+from orchestra.supervise.reaper import MARK_VARIABLE, Watchdog
+tmp = sys.argv[1]
+watchdog = Watchdog()
+if os.fork() == 0:   # a node caught between fork and exec, no parent-death signal yet
+    time.sleep(0.4)
+    os.execve("/bin/sh", ["sh", "-c", "echo $$ > %s/late; exec sleep 1000" % tmp],
+              dict(os.environ, **{MARK_VARIABLE: watchdog.mark}))
+print("forked", flush=True)
+time.sleep(1000)
+"""
+
+
+def test_a_node_that_execs_after_orchestra_was_killed_is_still_killed(tmp_path):
+    """The parent-death signal is set after the fork (setpriv) and the mark is seen only
+    after the exec, so a node being spawned when orchestra is SIGKILLed escaped both the
+    signal and the watchdog's scan (a rosout left running by a killed ``orchestra core``)."""
+    proc = subprocess.Popen([sys.executable, "-c", SLOW_SPAWN, str(tmp_path)],
+                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    late = tmp_path / "late"
+    try:
+        assert proc.stdout.readline() == "forked\n"
+        proc.kill()
+        proc.wait()
+        deadline = time.monotonic() + 10
+        while not (late.exists() and late.read_text().strip()):
+            assert time.monotonic() < deadline, "the late node never started"
+            time.sleep(0.02)
+        assert wait_dead([int(late.read_text())]) == []
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+        proc.stdout.close()
+        if late.exists() and late.read_text().strip() and alive(int(late.read_text())):
+            os.kill(int(late.read_text()), signal.SIGKILL)
+
+
 def test_script_without_shebang_is_a_spawn_failure_in_every_mode(tmp_path):
     script = tmp_path / "noshebang"
     script.write_text("echo hi\n")

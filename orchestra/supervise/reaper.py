@@ -31,6 +31,7 @@ import os
 import shutil
 import signal
 import subprocess
+import time
 import warnings
 from collections.abc import Callable, Iterable, Iterator, Mapping
 
@@ -38,6 +39,9 @@ logger = logging.getLogger(__name__)
 
 PR_SET_PDEATHSIG = 1
 MARK_VARIABLE = "ORCHESTRA_RUN_MARK"
+#: how long (s) the watchdog of a killed orchestra looks for marked processes, and how often
+SPAWN_GRACE = 1.0
+SPAWN_SCAN = 0.05
 
 # psutil and ctypes are imported where they are used (the stray scan without /proc, the
 # preexec fallback): a launch imports this module before its first node starts
@@ -316,11 +320,18 @@ def _watchdog_main(read_fd: int, mark: str, mask: Iterable[int]) -> None:
         except OSError as exc:
             if exc.errno not in (errno.ESRCH, errno.EPERM):
                 raise
-    # strays that left their node's group (setsid): found by the mark they inherited; a
-    # second pass catches any a dying process forked while the first one ran
-    for _ in range(2):
+    # strays that left their node's group (setsid): found by the mark they inherited. The
+    # scan goes on for SPAWN_GRACE: a node orchestra was spawning when it died carries the
+    # mark only once it has exec'd, and a child forked before its parent-death signal was
+    # set (setpriv sets it after the fork) outlives orchestra; on a busy machine that exec
+    # came up to ~0.3 s after the fork (a rosout spawned as `orchestra core` was killed)
+    end = time.monotonic() + SPAWN_GRACE
+    while True:
         for pid in marked_pids(mark):
             try:
                 os.kill(pid, signal.SIGKILL)
             except OSError:
                 pass
+        if time.monotonic() >= end:
+            return
+        time.sleep(SPAWN_SCAN)
