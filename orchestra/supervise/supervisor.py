@@ -617,7 +617,7 @@ class Supervisor:
         if signum not in _STOP_SIGNALS:
             return
         self._signal_count += 1
-        name = signal.Signals(signum).name
+        name = stop_signals.name(signum)
         if self._signal_count == 1:
             self.screen.message(f"orchestra: {name} received, stopping all nodes", err=True)
             self.request_stop(f"{name} received")
