@@ -8,7 +8,6 @@ the same value for the same id during one run (roslaunch's ``$(anon x)`` contrac
 from __future__ import annotations
 
 import os
-import random
 import re
 import sys
 
@@ -120,6 +119,8 @@ def anonymous_name(anon_id: str) -> str:
     """
     cached = _ANON.get(anon_id)
     if cached is None:
+        import random  # only anon names need it (~1 ms of every short process otherwise)
+
         raw = f"{anon_id}_{_host_token()}_{os.getpid()}_{random.randint(0, sys.maxsize)}"
         cached = raw.replace(".", "_").replace("-", "_").replace(":", "_")
         _ANON[anon_id] = cached

@@ -2,7 +2,7 @@
 import pytest
 
 from orchestra.errors import OrchestraError
-from orchestra.launch.xml import parse_file, parse_string
+from orchestra.launch.xml import MAX_DEPTH, parse_file, parse_string
 
 
 def test_entities_carry_tag_attributes_children_and_lines():
@@ -33,22 +33,59 @@ def test_document_without_launch_element_is_rejected():
         parse_string("<robot/>", "r.xml")
 
 
-def test_external_entities_are_not_expanded(tmp_path):
+def test_external_entity_declaration_is_refused_at_its_line(tmp_path):
     secret = tmp_path / "secret.txt"
     secret.write_text("TOPSECRET")
-    doc = (f'<?xml version="1.0"?>\n<!DOCTYPE launch [<!ENTITY xxe SYSTEM "file://{secret}">]>\n'
+    doc = (f'<?xml version="1.0"?>\n<!DOCTYPE launch [\n<!ENTITY xxe SYSTEM "file://{secret}">]>\n'
            '<launch><param name="p" value="x"/><rosparam>a: &xxe;</rosparam></launch>')
-    root = parse_string(doc, "xxe.launch")
-    assert "TOPSECRET" not in (root.children[1].text or "")
-    assert all("TOPSECRET" not in v for c in root.children for v in c.attributes.values())
+    with pytest.raises(OrchestraError, match="entity declarations") as info:
+        parse_string(doc, "xxe.launch")
+    assert str(info.value).startswith("xxe.launch:3:1: ")
+    assert "TOPSECRET" not in str(info.value)
 
 
-def test_billion_laughs_does_not_expand():
+def test_billion_laughs_is_refused_before_any_expansion():
     doc = ('<?xml version="1.0"?><!DOCTYPE launch [<!ENTITY a "aaaaaaaaaa">'
            '<!ENTITY b "&a;&a;&a;&a;&a;&a;&a;&a;&a;&a;"><!ENTITY c "&b;&b;&b;&b;&b;&b;&b;&b;">]>'
            '<launch><rosparam>x: &c;</rosparam></launch>')
-    root = parse_string(doc, "lol.launch")
-    assert len(root.children[0].text or "") < 100
+    with pytest.raises(OrchestraError, match="entity declarations"):
+        parse_string(doc, "lol.launch")
+
+
+def test_multi_line_start_tag_records_the_line_where_it_begins():
+    # the line an element records (the plan's) is the line of its '<', as exact positions are
+    root = parse_string('<launch>\n<node name="n"\n      if="$(eval 2 > 1)"\n      pkg="p" type="t"\n'
+                        '/>\n</launch>\n', "m.launch")
+    node = root.children[0]
+    assert node.location.line == 2
+    assert str(node.where()) == "m.launch:2:1"
+    assert str(node.where("pkg")) == "m.launch:4:7"
+
+
+def test_namespaced_names_are_kept_as_written_and_declarations_dropped():
+    root = parse_string('<launch xmlns="urn:a" xmlns:x="urn:x"><x:node x:a="1" b="2"/></launch>')
+    assert root.attributes == {}
+    assert (root.children[0].tag, root.children[0].attributes) == ("x:node", {"x:a": "1", "b": "2"})
+
+
+def test_launch_element_inside_another_root_is_found_with_exact_positions():
+    root = parse_string("<robot>\n  <x/>\n  <launch>\n    <node a='1'/></launch></robot>", "r.xml")
+    assert root.tag == "launch"
+    assert str(root.children[0].where("a")) == "r.xml:4:11"
+
+
+def test_text_of_an_element_joins_text_cdata_and_character_references():
+    root = parse_string("<launch><rosparam>a: &amp;x&#10;<![CDATA[b: <y>]]></rosparam></launch>")
+    assert root.children[0].text == "a: &x\nb: <y>"
+
+
+def test_elements_nested_deeper_than_the_bound_are_refused_at_their_line():
+    def doc(depth):
+        return "<launch>\n" + "<group>" * (depth - 1) + "</group>" * (depth - 1) + "</launch>"
+    assert parse_string(doc(MAX_DEPTH), "d").tag == "launch"
+    with pytest.raises(OrchestraError, match=f"nested more than {MAX_DEPTH} deep") as info:
+        parse_string(doc(MAX_DEPTH + 1), "d")
+    assert str(info.value).startswith("d:2:")
 
 
 def test_missing_file_is_a_user_error(tmp_path):

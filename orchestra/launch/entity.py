@@ -27,8 +27,8 @@ class Entity:
     """A tag with its attributes (name -> raw string, in file order), children and text.
 
     ``text`` is the element's own text (inline YAML of ``<rosparam>``), ``None`` when empty.
-    ``location`` points at the element's start tag (the line lxml reports for XML, which
-    the plan records); ``positions``, when the front end knows them, give the exact
+    ``location`` points at the element's start tag (the line it begins on, which the plan
+    records); ``positions``, when the front end knows them, give the exact
     position of the start tag and of each attribute name, so errors and ``orchestra check``
     point at the column without reading the file again. Positions are not part of equality:
     the same element read from XML or YAML is equal.

@@ -1,19 +1,25 @@
 """The XML front end: a roslaunch XML file -> an ``Entity`` tree with file:line locations.
 
-The parser is deliberately locked down (no DTD loading, no entity expansion, no network) so
-that a launch file cannot read local files or reach the network through XML tricks (XXE).
-Like roslaunch, the document must hold exactly one ``<launch>`` element; that element is the
-root Entity. Text of an element is the concatenation of its own text pieces (what
-roslaunch hands to ``<rosparam>`` as inline YAML), comments excluded.
+It reads with the standard library's expat, the parser roslaunch itself reads with (through
+minidom), so a document is well-formed here exactly when it is there, and names are what the
+file writes (``prefix:local``, no namespace processing, as minidom gives them). expat is also
+a fifth of a short ``orchestra launch --dump-params`` cheaper than lxml: the process does
+not load lxml's 10 MB library (~10 ms).
+
+The parser is locked down: a document that declares entities (``<!ENTITY>`` in a DOCTYPE) is
+refused, so a launch file cannot read local files or reach the network through XML tricks
+(XXE) nor blow up in memory (billion laughs); nothing else is ever loaded. Like roslaunch, the
+document must hold exactly one ``<launch>`` element; that element is the root Entity. Text
+of an element is the concatenation of its own text pieces (what roslaunch hands to
+``<rosparam>`` as inline YAML), comments excluded.
 """
 from __future__ import annotations
 
 import bisect
 import re
+from xml.parsers import expat
 
-from lxml import etree
-
-from orchestra.errors import Location, OrchestraError
+from orchestra.errors import Location, OrchestraError, offset_location
 from orchestra.launch.entity import Entity
 
 
@@ -21,33 +27,18 @@ class LaunchSyntaxError(OrchestraError):
     """The file is not well-formed XML or has no single ``<launch>`` element."""
 
 
-def _parser() -> etree.XMLParser:
-    # comments are dropped while parsing (libxml2 joins the text around one, which is the
-    # element text this front end gives); ``orchestra convert`` reads them with its own
-    return etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False,
-                           dtd_validation=False, huge_tree=False, remove_pis=True,
-                           remove_comments=True)
-
-
-def _qualified(element: etree._Element, name: str) -> str:
-    """Keep ``prefix:local`` spellings for namespaced tags and attributes (as minidom does)."""
-    if not name.startswith("{"):
-        return name
-    qname = etree.QName(name)
-    prefix = None
-    for pfx, uri in (element.nsmap or {}).items():
-        if uri == qname.namespace and pfx:
-            prefix = pfx
-            break
-    return f"{prefix}:{qname.localname}" if prefix else qname.localname
+# Elements nested deeper than this are refused (the bound libxml2 has by default, kept when
+# the front end moved to expat, which has none): everything after the parse walks the tree
+# recursively, and a file must not be able to exhaust the stack (docs/compat.md).
+MAX_DEPTH = 256
 
 
 # -- exact positions -----------------------------------------------------------------------
-# lxml reports one line per element (where libxml2 finished reading its start tag) and no
-# columns. The exact position of each start tag and attribute name is read once from the
-# text, here in the front end that owns it, by a scan of the (already known well-formed)
-# document: comments, CDATA, processing instructions and declarations are skipped, every
-# other '<name' opens the next element in document order.
+# Each element keeps the line its start tag begins on (expat's, for free) and no column.
+# The exact position of each start tag and attribute name is read once from the text, here
+# in the front end that owns it, by a scan of the (already known well-formed) document:
+# comments, CDATA, processing instructions and declarations are skipped, every other
+# '<name' opens the next element in document order.
 
 _MARKUP = re.compile(r"<(?:!--.*?-->|!\[CDATA\[.*?\]\]>|\?.*?\?>|![^>]*>|/[^>]*>|([^\s/>!?]+))",
                      re.S)
@@ -64,8 +55,9 @@ class _Document:
     def __init__(self, data: bytes, filename: str, elements: int):
         self.data = data
         self.filename = filename
-        self.elements = elements  # element count lxml saw: the scan must find as many
-        self.index_of: dict[int, int] = {}  # id(entity) -> its index in document order
+        self.elements = elements  # element count the parser saw: the scan must find as many
+        self.entities: list[Entity] = []  # every element, in document order
+        self._index_of: dict[int, int] | None = None  # id(entity) -> its index
         self._text: str | None = None
         self._tags: list[int] | None = None
         self._line_starts: list[int] | None = None
@@ -83,8 +75,11 @@ class _Document:
 
     def _offset(self, entity: Entity) -> int | None:
         """Where ``entity``'s start tag is; None when the scan does not see the elements
-        lxml saw (an encoding or construct it does not follow: lxml's line stands)."""
-        index = self.index_of.get(id(entity))
+        the parser saw (an encoding or construct it does not follow: the element's line
+        stands)."""
+        if self._index_of is None:
+            self._index_of = {id(e): i for i, e in enumerate(self.entities)}
+        index = self._index_of.get(id(entity))
         tags = self._scan()
         return tags[index] if index is not None and tags is not None else None
 
@@ -122,87 +117,68 @@ def _decode(data: bytes) -> str:
         return data.decode("latin-1")  # positions of ASCII markup stay right
 
 
-def _prefixes_possible(data: bytes | None) -> bool:
-    """Whether an attribute of the document may have a namespace prefix (``a:b``): only
-    prefixed attribute names are in a namespace (a default ``xmlns`` applies to tags, which
-    say so themselves), and names are written literally, so in an ASCII-compatible
-    encoding a document without a ``:`` byte has none. Others (UTF-16/32, EBCDIC): maybe."""
-    if data is None:
-        return True
-    head = data[3:64] if data.startswith(b"\xef\xbb\xbf") else data[:64]
-    head = head.lstrip(b" \t\r\n")
-    return b":" in data or head[:1] != b"<" or head[1:2] == b"\x00"
+class _EntityDeclared(Exception):
+    """Raised from expat's entity declaration handler to stop the parse (see the module);
+    ``offset`` is the byte offset expat was at, just after the declaration."""
+
+    def __init__(self, offset: int):
+        super().__init__()
+        self.offset = offset
 
 
-def _entities(start: etree._Element, filename: str, document: _Document | None,
-              prefixes: bool, first_index: int) -> tuple[Entity, int, int]:
-    """The Entity of ``start`` and its subtree, in one pass over the elements in document
-    order; and how many elements and ``<launch>`` elements were seen.
+class _TooDeep(Exception):
+    """Raised from the start tag handler at an element nested deeper than MAX_DEPTH."""
 
-    Each element's attributes, text pieces and line are read once (lxml's property access
-    is most of the cost); positions are only recorded as the element's index in the
-    document, resolved by ``_Document`` when asked for."""
-    count = first_index   # the index of the next element
-    launches = 0
-    index_of = document.index_of if document is not None else None
+    def __init__(self, location: Location):
+        super().__init__()
+        self.location = location
 
-    def entity(element: etree._Element) -> Entity:
-        nonlocal count, launches
-        index = count
-        count = index + 1
-        tag = element.tag
+
+def _read(data: bytes, filename: str, document: _Document) -> tuple[list[Entity], list[int]]:
+    """Every element of ``data`` as an Entity (children linked), in document order, and the
+    indexes of the ``<launch>`` elements among them. One pass of expat's events: an Entity
+    is made when its start tag is read; text goes to the innermost open one."""
+    parser = expat.ParserCreate()
+    parser.buffer_text = True  # one text event between two tags, not one per line
+    entities: list[Entity] = []
+    launches: list[int] = []
+    open_entities: list[Entity] = []
+    namespaced = b"xmlns" in data  # declarations are attributes to expat, not to roslaunch
+
+    def start(tag: str, attributes: dict[str, str]) -> None:
+        if len(open_entities) == MAX_DEPTH:
+            raise _TooDeep(Location(filename, parser.CurrentLineNumber,
+                                    parser.CurrentColumnNumber + 1))
+        if namespaced:
+            attributes = {k: v for k, v in attributes.items()
+                          if k != "xmlns" and not k.startswith("xmlns:")}
+        made = Entity(tag, attributes, [], None, Location(filename, parser.CurrentLineNumber),
+                      document)
         if tag == "launch":
-            launches += 1
-        elif tag[0] == "{":
-            tag = _qualified(element, tag)
-        children = []
-        text = element.text
-        if len(element):  # most elements are leaves: no iterator for them
-            pieces = None
-            for child in element:
-                if child.tag.__class__ is str:
-                    children.append(entity(child))
-                tail = child.tail
-                if tail:
-                    if pieces is None:
-                        pieces = [text] if text else []
-                    pieces.append(tail)
-            if pieces is not None:
-                text = "".join(pieces)
-        attributes = dict(element.items())
-        if prefixes:
-            for name in attributes:
-                if name[0] == "{":
-                    attributes = {_qualified(element, k): v for k, v in attributes.items()}
-                    break
-        made = Entity(tag, attributes, children, text or None,
-                      Location(filename, element.sourceline), document)
-        if index_of is not None:
-            index_of[id(made)] = index
-        return made
+            launches.append(len(entities))
+        entities.append(made)
+        if open_entities:
+            open_entities[-1].children.append(made)
+        open_entities.append(made)
 
-    root = entity(start)
-    return root, count - first_index, launches
+    def end(tag: str) -> None:
+        open_entities.pop()
 
+    def text(data: str) -> None:
+        if open_entities:  # text outside the root element is whitespace: not the tree's
+            innermost = open_entities[-1]
+            before = innermost.text
+            innermost.text = data if before is None else before + data
 
-def _root(tree: etree._Element, filename: str, data: bytes | None = None) -> Entity:
-    prefixes = _prefixes_possible(data)
-    if tree.tag == "launch":
-        # the usual document: the walk from the root sees every element
-        start, first, elements = tree, 0, None
-    else:
-        found = [el for el in tree.iter() if isinstance(el.tag, str)]
-        launches = [i for i, el in enumerate(found) if el.tag == "launch"]
-        if len(launches) != 1:
-            raise _launch_count_error(len(launches), filename)
-        start, first, elements = found[launches[0]], launches[0], len(found)
-    document = _Document(data, filename, elements or 0) if data is not None else None
-    root, seen, launch_count = _entities(start, filename, document, prefixes, first)
-    if launch_count != 1:
-        raise _launch_count_error(launch_count, filename)
-    if document is not None and elements is None:
-        document.elements = seen
-    return root
+    def entity_declared(*_: object) -> None:
+        raise _EntityDeclared(parser.CurrentByteIndex)
+
+    parser.StartElementHandler = start
+    parser.EndElementHandler = end
+    parser.CharacterDataHandler = text
+    parser.EntityDeclHandler = entity_declared
+    parser.Parse(data, True)
+    return entities, launches
 
 
 def _launch_count_error(found: int, filename: str) -> LaunchSyntaxError:
@@ -210,23 +186,30 @@ def _launch_count_error(found: int, filename: str) -> LaunchSyntaxError:
                              f"element (found {found})", Location(filename, 1))
 
 
-def _syntax_error(exc: etree.XMLSyntaxError, filename: str) -> LaunchSyntaxError:
-    line, column = getattr(exc, "position", (None, None)) or (None, None)
-    if line is None:
-        line = getattr(exc, "lineno", None)
-    message = getattr(exc, "msg", None) or str(exc)
-    return LaunchSyntaxError(f"invalid XML: {message}", Location(filename, line, column))
-
-
 def parse_bytes(data: bytes, filename: str) -> Entity:
     """Parse XML bytes (encoding from the XML declaration, default UTF-8)."""
+    document = _Document(data, filename, 0)
     try:
-        tree = etree.fromstring(data, _parser())
-    except etree.XMLSyntaxError as exc:
-        raise _syntax_error(exc, filename) from None
-    if tree is None:
-        raise LaunchSyntaxError("invalid XML: empty document", Location(filename, 1))
-    return _root(tree, filename, data)
+        entities, launches = _read(data, filename, document)
+    except expat.ExpatError as exc:
+        message = expat.ErrorString(exc.code) if exc.code else str(exc)
+        raise LaunchSyntaxError(f"invalid XML: {message}",
+                                Location(filename, exc.lineno, exc.offset + 1)) from None
+    except _EntityDeclared as exc:
+        declared = data.rfind(b"<!ENTITY", 0, exc.offset + 1)
+        raise LaunchSyntaxError(
+            "invalid XML: entity declarations (<!ENTITY>) are not allowed in launch files: "
+            "use <arg> for values to reuse",
+            offset_location(filename, data, declared if declared >= 0 else exc.offset)) \
+            from None
+    except _TooDeep as exc:
+        raise LaunchSyntaxError(f"invalid XML: elements nested more than {MAX_DEPTH} deep",
+                                exc.location) from None
+    if len(launches) != 1:
+        raise _launch_count_error(len(launches), filename)
+    document.elements = len(entities)
+    document.entities = entities
+    return entities[launches[0]]
 
 
 def parse_string(text: str, filename: str = "<string>") -> Entity:
