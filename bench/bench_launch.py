@@ -9,8 +9,8 @@
 3. ``$(find)`` cost per call once the package index is built (it must not re-crawl).
 4. The real ROS 1 roslaunch (Debian's 1.15, /usr/bin) as the baseline users care about, in
    the same run: ``roslaunch --dump-params`` vs ``orchestra launch --dump-params`` per case
-   (one process per case, interleaved), roslaunch's ``XmlLoader`` (what ``--dump-params``
-   runs) over all cases inside one ROS 1 interpreter vs orchestra's interpreter in-process,
+   (one process per case, interleaved, each case's median of 5 runs per side), roslaunch's
+   ``XmlLoader`` (what ``--dump-params`` runs) over all cases inside one ROS 1 interpreter vs orchestra's interpreter in-process,
    and the synthetic tree through both. Cases real roslaunch cannot load here (e.g. xacro
    ``command=`` params without xacro installed) are counted and left out of both sides.
    Skipped with a message without ROS 1.
@@ -204,7 +204,7 @@ def _subprocess_times(argv: list[str], env: dict) -> tuple[float, float, bool]:
         proc.returncode == 0 and b"Unable to load file" not in proc.stderr
 
 
-def bench_cases(samples: int, rounds: int, rows: list) -> None:
+def bench_cases(samples: int, rounds: int, repeats: int, rows: list) -> None:
     cases = json.loads((COMPAT / "cases.json").read_text())
     ws = str(COMPAT / "ws")
     jobs = []
@@ -269,28 +269,33 @@ def bench_cases(samples: int, rounds: int, rows: list) -> None:
 
     sub_jobs = both[:samples]
     o_sub, r_sub, bare_sub, o_cpu, r_cpu = [], [], [], [], []
-    for i in sub_jobs:  # interleaved: each case through orchestra, then through roslaunch
-        path, words, env = jobs[i]
-        t, cpu, ok = _subprocess_times(_pinned([orchestra_script(), "launch", "--dump-params",
-                                                path, *words]), _orchestra_env(env))
-        if ok:
-            o_sub.append(t)
-            o_cpu.append(cpu)
-        t, cpu, ok = _subprocess_times(_pinned([roslaunch, "--dump-params", path, *words]),
-                                       ros1.base_env(**env))
-        if ok:
-            r_sub.append(t)
-            r_cpu.append(cpu)
+    for i in sub_jobs:  # interleaved: each case through orchestra, roslaunch and python -S,
+        path, words, env = jobs[i]        # `repeats` times; each side keeps its median
         bare, bare_env = _without_site_hooks(env)
-        t, ok = _subprocess_time(_pinned([*bare, "launch", "--dump-params", path, *words]),
-                                 bare_env)
-        if ok:
-            bare_sub.append(t)
-    rows.append((f"--dump-params, one process per case, median of {len(sub_jobs)}",
+        runs: dict[str, list[tuple[float, float]]] = {"o": [], "r": [], "b": []}
+        for _ in range(repeats):
+            for side, argv, side_env in (
+                    ("o", [orchestra_script(), "launch", "--dump-params", path, *words],
+                     _orchestra_env(env)),
+                    ("r", [roslaunch, "--dump-params", path, *words], ros1.base_env(**env)),
+                    ("b", [*bare, "launch", "--dump-params", path, *words], bare_env)):
+                t, cpu, ok = _subprocess_times(_pinned(argv), side_env)
+                if ok:
+                    runs[side].append((t, cpu))
+        if not (runs["o"] and runs["r"]):
+            continue
+        o_sub.append(statistics.median(t for t, _ in runs["o"]))
+        o_cpu.append(statistics.median(c for _, c in runs["o"]))
+        r_sub.append(statistics.median(t for t, _ in runs["r"]))
+        r_cpu.append(statistics.median(c for _, c in runs["r"]))
+        if runs["b"]:
+            bare_sub.append(statistics.median(t for t, _ in runs["b"]))
+    each = f"median of {repeats} interleaved runs per case"
+    rows.append((f"--dump-params, one process per case, median of {len(o_sub)} cases",
                  f"{statistics.median(o_sub) * 1e3:.0f} ms",
                  f"{statistics.median(r_sub) * 1e3:.0f} ms",
                  statistics.median(o_sub) / statistics.median(r_sub), ""))
-    rows.append((f"  whole corpus, sum over the {len(sub_jobs)} cases", f"{sum(o_sub):.1f} s",
+    rows.append((f"  whole corpus, sum over the {len(o_sub)} cases ({each})", f"{sum(o_sub):.1f} s",
                  f"{sum(r_sub):.1f} s", sum(o_sub) / sum(r_sub), "<= 0.2x"))
     rows.append(("  same, CPU time (user + system) of the processes", f"{sum(o_cpu):.1f} s",
                  f"{sum(r_cpu):.1f} s", sum(o_cpu) / sum(r_cpu), ""))
@@ -474,7 +479,7 @@ def main() -> int:
     rows: list = []
     bench_startup(7 if opts.quick else 15, rows)
     if COMPAT.is_dir():
-        bench_cases(samples, rounds, rows)
+        bench_cases(samples, rounds, 3 if opts.quick else 5, rows)
     else:
         print("../shared/compat not found: skipping the compat cases")
     bench_synthetic(1 if opts.quick else 2, rows)
