@@ -10,9 +10,10 @@
 4. The real ROS 1 roslaunch (Debian's 1.15, /usr/bin) as the baseline users care about, in
    the same run: ``roslaunch --dump-params`` vs ``orchestra launch --dump-params`` per case
    (one process per case, interleaved, each case's median of 5 runs per side), roslaunch's
-   ``XmlLoader`` (what ``--dump-params`` runs) over all cases inside one ROS 1 interpreter vs orchestra's interpreter in-process,
-   and the synthetic tree through both. Cases real roslaunch cannot load here (e.g. xacro
-   ``command=`` params without xacro installed) are counted and left out of both sides.
+   ``XmlLoader`` (what ``--dump-params`` runs) over all cases inside one ROS 1 interpreter vs
+   orchestra's interpreter in-process, and the synthetic tree through both. Cases real
+   roslaunch cannot load here (e.g. xacro ``command=`` params without xacro installed) are
+   counted and left out of both sides.
    Skipped with a message without ROS 1.
 5. Start-up: ``orchestra --help`` and ``orchestra launch --dump-params`` of a one-node file
    against a bare ``python -c pass``, interleaved, medians.
