@@ -9,7 +9,14 @@ from hypothesis import strategies as st
 from orchestra.errors import OrchestraError
 from orchestra.params.dump_launch import dump_launch_params, plain_document
 from orchestra.params.dump_launch_yaml import LaunchParamsDumper, _c_emits_the_same
-from orchestra.params.yaml import flatten, load_rosparam_yaml
+from orchestra.params.yaml import (
+    RosparamLoader,
+    RosparamYamlError,
+    _check_bounds,
+    flatten,
+    load_rosparam_yaml,
+    load_yaml_value,
+)
 
 
 def test_degrees_and_radians_tags_become_radians():
@@ -75,6 +82,55 @@ def test_hostile_values_are_refused_at_their_position(text, position, why):
     if position is not None:
         assert location.line == position[0]
         assert position[1] is None or location.column == position[1]
+
+
+# scalars written plainly, each resolving to another tag (int, float, bool, null, str, timestamp)
+_WORDS = st.sampled_from(["1", "-2", "0x1f", "1_000", "017", "1.5", "1e3", "1.0e3", ".nan", ".inf",
+                          "yes", "No", "off", "~", "null", "x", "abc", "'q'", "2001-12-14",
+                          "1:20", "<<", "=", "1" * 1301])
+
+
+def _flow(children):
+    return children.map(lambda c: "[" + ", ".join(c) + "]")
+
+
+_FLOW = st.recursive(_WORDS, lambda inner: _flow(st.lists(inner, max_size=3)) | st.lists(
+    st.tuples(_WORDS, inner), max_size=3).map(
+        lambda kv: "{" + ", ".join(f"{k}: {v}" for k, v in kv) + "}"), max_leaves=8)
+
+
+def _two_passes(text):
+    """What load_yaml_value returned before its one-pass builder: the bounds checked over the
+    node graph, then PyYAML's constructor."""
+    loader = RosparamLoader(text)
+    try:
+        node = loader.get_single_node()
+        _check_bounds(node, "<yaml>")
+        return loader.construct_document(node)
+    finally:
+        loader.dispose()
+
+
+_NEAR_THE_BOUND = st.integers(93, 99) | st.integers(0, 99)  # levels of lists around an alias
+
+
+@settings(max_examples=400, deadline=None)
+@given(_FLOW, _NEAR_THE_BOUND, _NEAR_THE_BOUND, _FLOW)
+def test_one_pass_build_is_pyyamls_constructor_with_aliases_near_the_depth_bound(
+        shared, deep_a, deep_b, other):
+    """Values, types and which collections are one object (an alias names one again: yaml.dump
+    writes it with an anchor) are PyYAML's; a document is refused exactly when it is too deep
+    or holds a too long integer wherever an alias puts it."""
+    text = (f"a: &A {shared}\nb: {'[' * deep_a}*A{']' * deep_a}\nc: {other}\n"
+            f"d: [{'[' * deep_b}*A{']' * deep_b}, *A]\n")
+    try:
+        expected = yaml.dump(_two_passes(text))
+    except (RosparamYamlError, yaml.YAMLError, ValueError) as exc:
+        with pytest.raises(OrchestraError) as info:
+            load_yaml_value(text)
+        assert not isinstance(exc, RosparamYamlError) or exc.message == info.value.message
+        return
+    assert yaml.dump(load_yaml_value(text)) == expected
 
 
 _TEXT = st.text(alphabet=st.sampled_from(list("ab :#-'\"\\{}[],&*!|>%@`?=~.09eE+\n\t\x85é")),

@@ -90,26 +90,32 @@ _INT_TAG = "tag:yaml.org,2002:int"
 
 
 _resolve_tag = yaml.resolver.BaseResolver.resolve
+# (text, implicit) -> tag of RosparamLoader's scalars of up to _KEPT_TEXT characters, at
+# most _SCALAR_TAGS_LIMIT of them
+_SCALAR_TAGS: dict[tuple[str, Any], str] = {}
+_SCALAR_TAGS_LIMIT = 16384
+_KEPT_TEXT = 200
 
 
 class RosparamLoader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):  # type: ignore[misc]
     """PyYAML's safe loader (libyaml-backed when available: same results, much faster) plus
     rosparam's angle tags; a subclass, so the global loaders stay untouched."""
 
-    def __init__(self, stream: Any):
-        super().__init__(stream)
-        self._scalar_tags: dict[tuple[str, Any], str] = {}
-
     def resolve(self, kind: type, value: Any, implicit: Any) -> Any:
         # a scalar's tag depends on its text and quoting alone (this loader has no path
-        # resolvers), and keys and values recur throughout a document: each text is matched
-        # against the implicit resolvers' patterns once per document
+        # resolvers and its implicit resolvers are fixed), and keys and values recur
+        # throughout a document and across files: each text is matched against the
+        # patterns once per process (the table is emptied when it grows past its limit)
         if kind is not yaml.ScalarNode:
             return _resolve_tag(self, kind, value, implicit)
         key = (value, implicit)
-        tag = self._scalar_tags.get(key)
+        tag = _SCALAR_TAGS.get(key)
         if tag is None:
-            tag = self._scalar_tags[key] = _resolve_tag(self, kind, value, implicit)
+            tag = _resolve_tag(self, kind, value, implicit)
+            if len(value) <= _KEPT_TEXT:
+                if len(_SCALAR_TAGS) >= _SCALAR_TAGS_LIMIT:
+                    _SCALAR_TAGS.clear()
+                _SCALAR_TAGS[key] = tag
         return tag
 
     def construct_object(self, node: yaml.Node, deep: bool = False) -> Any:
@@ -145,11 +151,10 @@ def load_yaml_value(text: str, filename: str = "<yaml>") -> Any:
         node = loader.get_single_node()
         if node is None:
             return None
-        if "*" not in text:  # no alias can name a node twice: one pass checks and builds
-            try:
-                return _PlainBuilder(loader, set()).checked(node, 1)
-            except Exception:  # noqa: BLE001 - anything else: the passes below say what
-                pass
+        try:  # one pass checks and builds a plain document (nearly all)
+            return _PlainBuilder(loader, set()).checked(node, 1)
+        except Exception:  # noqa: BLE001 - anything else: the passes below say what
+            pass
         shared = _check_bounds(node, filename)
         if shared is not None:
             try:
@@ -227,6 +232,9 @@ _PLAIN_SCALAR_TAGS = frozenset({_STR_TAG, _INT_TAG, "tag:yaml.org,2002:float",
                                 "tag:yaml.org,2002:bool", "tag:yaml.org,2002:null"})
 
 
+_SCALAR = yaml.ScalarNode
+
+
 class _NotPlain(Exception):
     """The document is not one ``_PlainBuilder.checked`` builds."""
 
@@ -238,13 +246,23 @@ class _PlainBuilder:
     Nearly every rosparam file is one; PyYAML's constructor spends most of its time on what
     such a document never needs (two-phase construction for recursive structures, merge
     keys, per-object bookkeeping). A scalar it would refuse raises here, and the caller
-    then lets PyYAML's constructor raise its error as before."""
+    then lets PyYAML's constructor raise its error as before.
+
+    A scalar's value depends on its tag and text alone, and parameter files repeat the same
+    few texts (``0.0``, ``false``, the rows of covariance matrices): each (tag, text) is
+    constructed once per document. The values shared that way are immutable (numbers,
+    booleans, None), whose identity nothing observes (PyYAML itself gives every ``.nan`` the
+    same object)."""
 
     def __init__(self, loader: RosparamLoader, shared: set[int]):
         self.constructors = loader.yaml_constructors
         self.loader = loader
         self.shared = shared
         self.built: dict[int, Any] = {}
+        self.scalars: dict[tuple[str, str], Any] = {}
+        # for ``checked``: the levels below each collection met, the deepest level reached
+        self.levels: dict[int, int] = {}
+        self.deepest = 0
 
     def build(self, node: yaml.Node) -> Any:
         if self.shared and id(node) in self.shared:
@@ -254,31 +272,69 @@ class _PlainBuilder:
             return found
         return self._build(node)
 
-    def checked(self, node: yaml.Node, depth: int) -> Any:
-        """``build`` for a document without aliases that also makes ``_check_bounds``'
-        checks on the way; ``_NotPlain`` for anything they or ``build`` would not pass."""
-        if depth > MAX_DEPTH:
-            raise _NotPlain
-        kind = node.__class__
+    def scalar(self, node: yaml.ScalarNode) -> Any:
+        """The value of a scalar node (a string as is; others constructed once per text);
+        ``_NotPlain`` for a tag a plain document has not, or an oversized integer."""
         tag = node.tag
-        if kind is yaml.ScalarNode:
-            if tag == _STR_TAG:
-                return node.value
+        if tag == _STR_TAG:
+            return node.value
+        key = (tag, node.value)
+        value = self.scalars.get(key, _NotPlain)
+        if value is _NotPlain:
             if tag not in _PLAIN_SCALAR_TAGS or (tag == _INT_TAG
                                                  and len(node.value) > MAX_INT_TEXT):
                 raise _NotPlain
-            return self.constructors[tag](self.loader, node)
+            value = self.scalars[key] = self.constructors[tag](self.loader, node)
+        return value
+
+    def checked(self, node: yaml.Node, depth: int) -> Any:
+        """``build`` for a document that also makes ``_check_bounds``' checks on the way;
+        ``_NotPlain`` for anything they or ``build`` would not pass. A collection an alias
+        names again is the object already built, when its levels fit below the alias (and
+        it is not inside itself; otherwise ``_NotPlain``, and the two-pass path decides).
+        An alias of a scalar needs nothing: its value depends on its text alone and is
+        immutable. (Scalar children are read here rather than through a call per child:
+        most nodes of a parameter file are scalars in a list or a map.)"""
+        if depth > MAX_DEPTH:
+            raise _NotPlain
+        kind = node.__class__
+        if kind is _SCALAR:
+            return self.scalar(node)  # type: ignore[arg-type]
+        key = id(node)
+        levels = self.levels.get(key)
+        if levels is not None:  # named again by an alias
+            if key not in self.built or depth + levels > MAX_DEPTH:
+                raise _NotPlain
+            self.deepest = max(self.deepest, depth + levels)
+            return self.built[key]
+        self.levels[key] = 0  # being built
+        level, outer = depth, self.deepest
         depth += 1
-        if kind is yaml.MappingNode and tag == _MAP_TAG:
-            mapping = {}
-            for key, value in node.value:
-                if key.__class__ is not yaml.ScalarNode:
+        children = node.value
+        if children:
+            if depth > MAX_DEPTH:
+                raise _NotPlain
+            self.deepest = depth
+        else:
+            self.deepest = level
+        scalar, checked = self.scalar, self.checked
+        value: Any
+        if kind is yaml.MappingNode and node.tag == _MAP_TAG:
+            value = {}
+            for k, v in children:
+                if k.__class__ is not _SCALAR:
                     raise _NotPlain
-                mapping[self.checked(key, depth)] = self.checked(value, depth)
-            return mapping
-        if kind is yaml.SequenceNode and tag == _SEQ_TAG:
-            return [self.checked(child, depth) for child in node.value]
-        raise _NotPlain
+                value[scalar(k)] = scalar(v) if v.__class__ is _SCALAR else checked(v, depth)
+        elif kind is yaml.SequenceNode and node.tag == _SEQ_TAG:
+            value = [scalar(child) if child.__class__ is _SCALAR else checked(child, depth)
+                     for child in children]
+        else:
+            raise _NotPlain
+        self.levels[key] = self.deepest - level
+        self.built[key] = value
+        if outer > self.deepest:
+            self.deepest = outer
+        return value
 
     def _build(self, node: yaml.Node) -> Any:
         tag = node.tag
@@ -289,7 +345,7 @@ class _PlainBuilder:
             return {build(key): build(value) for key, value in node.value}
         if tag == _SEQ_TAG:
             return [self.build(child) for child in node.value]
-        return self.constructors[tag](self.loader, node)
+        return self.scalar(node)  # type: ignore[arg-type]
 
 
 def _node_location(filename: str, node: yaml.Node) -> Location:
