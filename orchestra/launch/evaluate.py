@@ -87,10 +87,27 @@ def evaluate(expr: str, args: Mapping[str, str], launch: Mapping[str, Callable[.
     types an arg's text the way bare names are typed. Raises ``EvalError`` (or the
     ``OrchestraError`` a launch function raised) for anything refused or failing."""
     try:
-        tree = expression.parse(expr, POLICY)
-        expression.validate(tree, POLICY)
+        tree = _checked_tree(expr)
         functions = {name: launch[name] for name in LAUNCH_FUNCTIONS}
         value = expression.evaluate(tree, POLICY, _TypedArgs(args, convert), functions)
         return expression.text_of(value)
     except ExpressionError as exc:
         raise EvalError(f"$(eval {clip(expr)}): {exc}") from None
+
+
+# Parsed and validated expressions by text: the same few (``$(eval arg('x') == 'y')``) recur
+# on many elements and in every file of a package, and the tree depends on the text alone
+# (the evaluator only reads it). Only accepted texts are kept; emptied past the limit.
+_TREES: dict[str, ast.Expression] = {}
+_TREES_LIMIT = 1024
+
+
+def _checked_tree(expr: str) -> ast.Expression:
+    tree = _TREES.get(expr)
+    if tree is None:
+        tree = expression.parse(expr, POLICY)
+        expression.validate(tree, POLICY)
+        if len(_TREES) >= _TREES_LIMIT:
+            _TREES.clear()
+        _TREES[expr] = tree
+    return tree
