@@ -112,8 +112,23 @@ def _flat_call(params: int) -> re.Pattern[str]:
         + "[ \t\n]*</params>[ \t\n]*</methodCall>")
 
 
-# up to 8 params (the Master API's longest call has 4); longer calls take the walk below
-_FLAT_CALLS = [_flat_call(params) for params in range(9)]
+# up to 8 params (the Master API's longest call has 4); longer calls take the walk below.
+# Each is compiled when a call of its length first comes: compiling all nine costs ~6 ms,
+# paid by every process that imports this module (the launcher, every node), which mostly
+# see calls of 1 to 4 params. (Two threads may both compile one: the same pattern.)
+_FLAT_CALLS: list[re.Pattern[str] | None] = [None] * 9
+
+
+def _flat_pattern(params: int) -> re.Pattern[str] | None:
+    """The whole-call pattern for ``params`` params, or None beyond the longest one."""
+    if params >= len(_FLAT_CALLS):
+        return None
+    pattern = _FLAT_CALLS[params]
+    if pattern is None:
+        pattern = _FLAT_CALLS[params] = _flat_call(params)
+    return pattern
+
+
 _T = _TOKEN.groupindex
 _TYPE, _TYPED, _UNTYPED, _NIL = _T["type"], _T["typed"], _T["untyped"], _T["nil"]
 _NAME, _METHOD = _T["name"], _T["method"]
@@ -192,8 +207,8 @@ def _loads_plain(data: bytes | bytearray) -> tuple[tuple[Any, ...], str | None] 
             return None
         start = decl.end()
     params_count = text.count("<param>")
-    flat = (_FLAT_CALLS[params_count].fullmatch(text, start)
-            if params_count < len(_FLAT_CALLS) else None)
+    pattern = _flat_pattern(params_count)
+    flat = pattern.fullmatch(text, start) if pattern is not None else None
     if flat is not None:
         name, *groups = flat.groups("")
         return (tuple([_scalar(groups[i] or None, groups[i + 1], groups[i + 2], groups[i + 3])
