@@ -29,10 +29,15 @@ halves with where the scheduler happens to put the two processes (same CPU: a di
 two CPUs: a cross-CPU wake-up per message), which made persistent service calls bimodal
 (0.4-3.2x from one run to the next). ``--pin none`` leaves placement to the scheduler.
 
-Service and 100 Hz rows run every pair in each of ``--rounds`` rounds, the pairs' order
-rotated each round; they print each round (with the load average when it began), the
-medians, and each round's ratio against rospy->rospy as ``median [min-max]``: one round
-that another process spoiled shows as such instead of deciding the figure. A round makes
+Service rows run every pair in each of ``--rounds`` rounds, the pairs' order rotated each
+round; they print each round (with the load average when it began), the medians, and each
+round's ratio against rospy->rospy as ``median [min-max]``: one round that another process
+spoiled shows as such instead of deciding the figure. The 100 Hz rows compare two pairs AT
+ONCE instead (orchestra's subscriber next to rospy's, fed by one rospy publisher; orchestra's
+publisher next to rospy's, read by one rospy subscriber), their messages 5 ms apart on
+absolute times, so both see the same machine; the tail of a 100 Hz stream is mostly how
+long the receiving thread waits for its CPU, which two runs seconds apart do not share.
+Every child runs in its own session (its own autogroup), as launched nodes do. A round makes
 ``--calls`` plain and ``--persistent-calls`` persistent calls per pair (a kept connection's
 call is ~10x faster, so 10x as many make a round of similar length), and the client's CPU
 per call is printed next to the rates.
@@ -207,6 +212,53 @@ def role_pub(kind: str, count: int, burst: int, gap: float) -> None:
     rospy.signal_shutdown("done")
 
 
+def role_multi_sub(topics: list[str]) -> None:
+    """One subscriber process on several Twist topics (the 100 Hz rows): every sample kept
+    per topic, so two publishers' messages reach the same subscriber process."""
+    rospy = node_api()
+    cls = message_class("geometry_msgs/Twist")
+    samples: dict[str, list[float]] = {t: [] for t in topics}
+
+    def callback(m, topic):
+        samples[topic].append(now() - m.linear.x)
+
+    rospy.init_node(f"bench_sub_{os.getpid()}", disable_signals=True)
+    for topic in topics:
+        rospy.Subscriber(topic, cls, callback, callback_args=topic, queue_size=10)
+    emit({"ready": True})
+    sys.stdin.readline()  # "latency done" from the parent
+    emit({"samples": samples})
+    rospy.signal_shutdown("done")
+
+
+def role_phase_pub(topics: list[str], phases: list[float], count: int, period: float,
+                   subscribers: int) -> None:
+    """Publish a Twist on each topic every ``period`` s at its own phase, on absolute times
+    from a start time the parent gives (CLOCK_MONOTONIC, shared by every process): two
+    publisher processes, or two topics of one, then send in turn ``period/2`` apart."""
+    rospy = node_api()
+    cls = message_class("geometry_msgs/Twist")
+    rospy.init_node(f"bench_pub_{os.getpid()}", disable_signals=True)
+    pubs = [rospy.Publisher(t, cls, queue_size=10) for t in topics]
+    msg = cls()
+    while any(p.get_num_connections() < subscribers for p in pubs):
+        time.sleep(0.01)
+    emit({"connected": True})
+    t0 = float(sys.stdin.readline())
+    order = sorted(zip(phases, pubs, strict=True), key=lambda x: x[0])
+    for k in range(count):
+        for phase, pub in order:
+            delay = t0 + k * period + phase - now()
+            if delay > 0:
+                time.sleep(delay)
+            msg.linear.x = now()
+            pub.publish(msg)
+    time.sleep(0.3)
+    emit({"latency_sent": count})
+    sys.stdin.readline()
+    rospy.signal_shutdown("done")
+
+
 def role_service() -> None:
     rospy = node_api()
     SetBool, Response = service_classes("std_srvs/SetBool")
@@ -315,7 +367,8 @@ def _raw_baseline(size: int, count: int, burst: int, calls: int, gap: float) -> 
 
 #: the CPU of each role under ``--pin split`` (None: unpinned); "master" is this process
 CPUS: dict[str, int] | None = None
-SPLIT = {"pub": 0, "client": 0, "raw_client": 0, "sub": 1, "service": 1, "raw_server": 1,
+SPLIT = {"pub": 0, "client": 0, "raw_client": 0, "phase_pub": 0, "sub": 1, "multi_sub": 1,
+         "service": 1, "raw_server": 1,
          "master": 1}
 
 
@@ -328,8 +381,11 @@ def child(env: dict, role: str, *args: str, impl: str = "orchestra") -> subproce
     else:
         python = sys.executable
     pin = ["--cpu", str(CPUS[role])] if CPUS else []
+    # each in its own session, as roslaunch and orchestra start nodes: its own autogroup,
+    # so it competes for its CPU as a launched node does
     return subprocess.Popen([python, HERE, "--impl", impl, "--role", role, *pin, *args], env=env,
-                            stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+                            stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
+                            start_new_session=True)
 
 
 def read(proc: subprocess.Popen, key: str) -> dict:
@@ -400,6 +456,12 @@ def main() -> None:
     parser.add_argument("--pin", default="split", choices=("split", "none"),
                         help="split: publishers/clients on CPU 0, subscribers/services and "
                              "the master on CPU 1; none: the scheduler decides")
+    parser.add_argument("--topics", default="", help="(multi_sub, phase_pub) comma-separated")
+    parser.add_argument("--phases", default="", help="(phase_pub) seconds, one per topic")
+    parser.add_argument("--subscribers", type=int, default=1,
+                        help="(phase_pub) connections to wait for on each topic")
+    parser.add_argument("--twist100-count", type=int, default=600,
+                        help="100 Hz messages per compared pair and round")
     parser.add_argument("--cpu", type=int, default=None, help="(child roles) run on this CPU")
     opts = parser.parse_args()
     global IMPL
@@ -410,6 +472,11 @@ def main() -> None:
         return role_sub(opts.kind, opts.count, opts.burst)
     if opts.role == "pub":
         return role_pub(opts.kind, opts.count, opts.burst, opts.gap)
+    if opts.role == "multi_sub":
+        return role_multi_sub(opts.topics.split(","))
+    if opts.role == "phase_pub":
+        return role_phase_pub(opts.topics.split(","), [float(x) for x in opts.phases.split(",")],
+                              opts.count, opts.gap, opts.subscribers)
     if opts.role == "service":
         return role_service()
     if opts.role == "client":
@@ -450,8 +517,7 @@ def main() -> None:
                         results["ros1"][f"{kind} {pub_impl}->{sub_impl}"] = bench_topic(
                             env, kind, count, burst, gap, pub_impl, sub_impl)
             if opts.rows in ("all", "twist100"):
-                results["twist100"] = twist100_rounds(env, SLOW_TWIST_COUNT,
-                                                      opts.rounds)
+                results["twist100"] = twist100_rounds(env, opts.twist100_count, opts.rounds)
             if opts.rows in ("all", "service"):
                 results["services"] = service_rounds(env, calls, persistent_calls, opts.rounds)
         else:
@@ -475,8 +541,6 @@ def main() -> None:
           f"{results['load_end'][0]:.2f} at the end, on {os.cpu_count()} cores")
 
 
-SLOW_TWIST_COUNT = 600  # messages per 100 Hz latency run (6 s, --quick too)
-
 PAIRS = [("orchestra", "orchestra"), ("rospy", "rospy"), ("orchestra", "rospy"),
          ("rospy", "orchestra")]
 SHORT = {"orchestra": "orch", "rospy": "rospy"}
@@ -493,20 +557,85 @@ def round_order(i: int) -> list[tuple[str, str]]:
     return PAIRS[k:] + PAIRS[:k]
 
 
-def twist100_rounds(env: dict, count: int, rounds: int) -> dict:
-    """Twist at 100 Hz (a robot's cmd_vel), latency only: every pair in each of ``rounds``
-    interleaved rounds. Kept per round (the spread) and pooled per pair (a p99 of one
-    round is its count/100-th worst message: one scheduler hiccup moves it by ms)."""
+#: the two comparisons of the 100 Hz rows: (name, the pair that differs from rospy->rospy,
+#: the side it differs on)
+TWIST100 = (("subscriber", ("rospy", "orchestra")), ("publisher", ("orchestra", "rospy")))
+
+
+def twist100_rounds(env: dict, count: int, rounds: int, period: float = 0.01) -> dict:
+    """Twist at 100 Hz (a robot's cmd_vel), latency only. Each comparison runs its two pairs
+    AT ONCE, their messages ``period/2`` apart on absolute times: orchestra's subscriber
+    and rospy's, both fed by one rospy publisher process (one topic each); then orchestra's
+    publisher and rospy's, both read by one rospy subscriber process. Both pairs of a
+    comparison so see the same machine, sampled alternately every 5 ms, instead of two runs
+    seconds apart whose p99s differ by what else ran then (on a shared machine that
+    difference was 0.2-6x). The phases swap every round; each round's p99 ratio and the
+    pooled one are kept."""
     per_round: list[dict] = []
-    pooled: dict[str, list[float]] = {}
+    pooled: dict[str, dict[str, list[float]]] = {}
     for i in range(rounds):
-        got = {"load": os.getloadavg()[0]}
-        for pair in round_order(i):
-            samples = bench_topic(env, "twist", count, 0, 0.01, *pair)["samples"]
-            got[pair_name(pair)] = summarize(samples)
-            pooled.setdefault(pair_name(pair), []).extend(samples)
+        got: dict = {"load": os.getloadavg()[0]}
+        for name, (pub_impl, sub_impl) in TWIST100[i % 2:] + TWIST100[:i % 2]:
+            pair, base = pair_name((pub_impl, sub_impl)), pair_name(("rospy", "rospy"))
+            topics = {pair: "/t100_orch", base: "/t100_rospy"}
+            phases = {pair: 0.0, base: period / 2} if i % 2 else {pair: period / 2, base: 0.0}
+            if name == "subscriber":  # one rospy publisher, a subscriber of each
+                subs = [(sub_impl, [topics[pair]]), ("rospy", [topics[base]])]
+                pubs = [("rospy", [topics[pair], topics[base]], [phases[pair], phases[base]])]
+            else:  # a publisher of each, one rospy subscriber
+                subs = [("rospy", [topics[pair], topics[base]])]
+                pubs = [(pub_impl, [topics[pair]], [phases[pair]]),
+                        ("rospy", [topics[base]], [phases[base]])]
+            samples = phase_run(env, subs, pubs, count, period)
+            got[name] = {k: summarize(samples[t]) for k, t in topics.items()}
+            for k, t in topics.items():
+                pooled.setdefault(name, {}).setdefault(k, []).extend(samples[t])
         per_round.append(got)
-    return {"rounds": per_round, "pooled": {k: summarize(v) for k, v in pooled.items()}}
+    return {"rounds": per_round,
+            "pooled": {name: {k: summarize(v) for k, v in pairs.items()}
+                       for name, pairs in pooled.items()}}
+
+
+def phase_run(env: dict, subs: list[tuple[str, list[str]]],
+              pubs: list[tuple[str, list[str], list[float]]], count: int,
+              period: float) -> dict[str, list[float]]:
+    """Subscriber processes, then publisher processes sending on phases of one shared
+    start time; every sample of every topic."""
+    procs: list[subprocess.Popen] = []
+    try:
+        sub_procs = []
+        for impl, topics in subs:
+            sub_procs.append(child(env, "multi_sub", "--topics", ",".join(topics), impl=impl))
+            procs.append(sub_procs[-1])
+        for proc in sub_procs:
+            read(proc, "ready")
+        pub_procs = []
+        for impl, topics, phases in pubs:
+            pub_procs.append(child(env, "phase_pub", "--topics", ",".join(topics), "--phases",
+                                   ",".join(map(str, phases)), "--count", str(count),
+                                   "--gap", str(period), impl=impl))
+            procs.append(pub_procs[-1])
+        for proc in pub_procs:
+            read(proc, "connected")
+        t0 = now() + 0.3  # every publisher has its connections: a common start
+        for proc in pub_procs:
+            tell(proc, repr(t0))
+        for proc in pub_procs:
+            read(proc, "latency_sent")
+        samples: dict[str, list[float]] = {}
+        for proc in sub_procs:
+            tell(proc, "latency done")
+            samples.update(read(proc, "samples")["samples"])
+        for proc in pub_procs:
+            tell(proc)
+        for proc in procs:
+            proc.wait(15)
+        return samples
+    finally:
+        for proc in procs:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait()
 
 
 def service_rounds(env: dict, calls: int, persistent_calls: int, rounds: int) -> dict:
@@ -603,26 +732,28 @@ def print_ros1(results: dict, plan: dict) -> None:
 
 
 def print_twist100(data: dict) -> None:
-    """The 100 Hz rows: pooled medians and p99s, each round's p99s, and the p99 ratios
-    against rospy->rospy per round (median and range) and pooled."""
-    cols = [pair_name(p) for p in PAIRS]
+    """The 100 Hz rows: for each comparison, both pairs' pooled medians and p99s, each
+    round's p99s, and the p99 ratio against rospy->rospy per round (median and range) and
+    pooled."""
     rounds, pooled = data["rounds"], data["pooled"]
-    print(f"\n{'Twist 100 Hz latency (pub->sub)':36.36}" + "".join(f"{c:>14}" for c in cols))
-    for key, name in (("median_us", "median, pooled (us)"), ("p99_us", "p99, pooled (us)")):
-        print(f"{name:36}" + "".join(f"{pooled[c][key]:14.0f}" for c in cols))
-    for i, r in enumerate(rounds, 1):
-        label = f"  p99 round {i} (load {r['load']:.1f})"
-        print(f"{label:36}"
-              + "".join(f"{r[c]['p99_us']:14.0f}" for c in cols))
     base = "rospy->rospy"
-    print(f"p99 of rospy->rospy / p99 of the pair (>= 1.0x: no worse than rospy; "
-          f"{len(rounds)} rounds of {rounds[0][cols[0]]['n']} messages per pair):")
-    for c in cols:
-        if c == base:
-            continue
-        ratios = [r[base]["p99_us"] / r[c]["p99_us"] for r in rounds]
-        print(f"  {c:14} per round {spread(ratios):24} pooled "
-              f"{pooled[base]['p99_us'] / pooled[c]['p99_us']:.2f}x")
+    print(f"\nTwist 100 Hz latency, the two pairs of a comparison run at once, 5 ms apart "
+          f"({len(rounds)} rounds)")
+    for name, pair in TWIST100:
+        col = pair_name(pair)
+        print(f"{'  which ' + name + ' (us)':36}{col:>14}{base:>14}{'ratio':>9}")
+        for key, label in (("median_us", "median, pooled"), ("p99_us", "p99, pooled")):
+            a, b = pooled[name][col][key], pooled[name][base][key]
+            print(f"{'    ' + label:36}{a:14.0f}{b:14.0f}{b / a:8.2f}x")
+        for i, r in enumerate(rounds, 1):
+            a, b = r[name][col]["p99_us"], r[name][base]["p99_us"]
+            label = f"    p99 round {i} (load {r['load']:.1f})"
+            print(f"{label:36}{a:14.0f}{b:14.0f}{b / a:8.2f}x")
+        ratios = [r[name][base]["p99_us"] / r[name][col]["p99_us"] for r in rounds]
+        print(f"    {col}: p99 of rospy->rospy / p99 of {col} per round {spread(ratios)}, "
+              f"pooled {pooled[name][base]['p99_us'] / pooled[name][col]['p99_us']:.2f}x "
+              f"({rounds[0][name][col]['n']} messages per pair and round; >= 1.0x: no worse "
+              f"than rospy)")
 
 
 def print_services(data: dict) -> None:
