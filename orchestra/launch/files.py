@@ -16,6 +16,7 @@ _MAX_STUB = 1024
 # The largest file a launch file may have read (launch, rosparam, textfile, binfile).
 MAX_FILE_BYTES = 256 * 2**20
 _MAX_HOPS = 8
+_PIECE = 2**20
 
 
 def _stub_target(path: str, data: bytes) -> str | None:
@@ -34,20 +35,41 @@ def _stub_target(path: str, data: bytes) -> str | None:
 
 def _read_regular(path: str) -> bytes:
     """A regular file's bytes, at most ``MAX_FILE_BYTES``: a launch file naming /dev/zero or a
-    FIFO must get an error, not exhaust memory or block forever."""
-    info = os.stat(path)
-    if not stat.S_ISREG(info.st_mode):
-        raise OSError(errno.EINVAL, "not a regular file", path)
-    with open(path, "rb") as fh:
-        # sized by the stat: read(n) allocates n bytes first, and a MAX_FILE_BYTES buffer
-        # per file costs more than reading a launch file; a file that grew since (or a
-        # /proc file, size 0) is read on up to the limit
-        data = fh.read(min(info.st_size, MAX_FILE_BYTES) + 1)
+    FIFO must get an error, not exhaust memory or block forever.
+
+    Read with the raw descriptor calls: opened non-blocking (a FIFO's open does not wait for
+    a writer), checked with ``fstat`` of that descriptor, read in one call sized by it (a
+    Python file object and a stat by path cost as much as the read of a launch file)."""
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)
+    try:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode):
+            raise OSError(errno.EINVAL, "not a regular file", path)
+        # one more byte than the stat says shows whether the file grew since (or is a
+        # /proc file, size 0); then it is read on, in pieces, up to the limit
+        wanted = min(info.st_size, MAX_FILE_BYTES) + 1
+        data = os.read(fd, wanted)
+        if 0 < len(data) < wanted - 1:  # short of the stat's size: a read may stop early
+            data += _read_rest(fd, wanted - len(data))
         if len(data) > info.st_size:
-            data += fh.read(MAX_FILE_BYTES + 1 - len(data))
+            data += _read_rest(fd, MAX_FILE_BYTES + 1 - len(data))
+    finally:
+        os.close(fd)
     if len(data) > MAX_FILE_BYTES:
         raise OSError(errno.EFBIG, f"larger than {MAX_FILE_BYTES // 2**20} MiB", path)
     return data
+
+
+def _read_rest(fd: int, most: int) -> bytes:
+    """Up to ``most`` more bytes of ``fd``, until its end (a read may return fewer bytes
+    than asked while more follow)."""
+    buf = bytearray()
+    while len(buf) < most:
+        piece = os.read(fd, min(most - len(buf), _PIECE))
+        if not piece:
+            break
+        buf += piece
+    return bytes(buf)
 
 
 def read_bytes(path: str) -> bytes:
