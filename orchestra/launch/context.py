@@ -58,6 +58,22 @@ class Scope:
     # ------------------------------------------------------------------ children
     def child(self, ns: str | None) -> Scope:
         """A scope inheriting everything; ``ns`` (relative, global or ``~``) nests it."""
+        # positional: a node or group makes several of these, and keyword calls cost more
+        return Scope(self._child_ns(ns), self.filename, self, self.params, list(self.env_args),
+                     dict(self.args), list(self.arg_names), self.include_args,
+                     self.pass_all_args, self.include_stack)
+
+    def node_child(self, ns: str | None) -> Scope:
+        """``child`` for a ``<node>``/``<test>`` (its namespace, then its private params).
+        Nothing read in there declares an arg or adds to this scope's ``<env>``s (a node's
+        own ``<env>`` and ``<remap>`` get a ``child`` of their own), so the args and env
+        are shared instead of copied: every node of a file with many args copied them
+        twice."""
+        return Scope(self._child_ns(ns), self.filename, self, self.params, self.env_args,
+                     self.args, self.arg_names, self.include_args, self.pass_all_args,
+                     self.include_stack)
+
+    def _child_ns(self, ns: str | None) -> str:
         if ns:
             if ns[0] == "/":
                 child_ns = ns
@@ -70,10 +86,7 @@ class Scope:
         if child_ns.startswith(PRIVATE):
             raise ScopeError(f"namespace [{child_ns}] is private: a namespace must be "
                              "relative or global")
-        # positional: a node or group makes several of these, and keyword calls cost more
-        return Scope(child_ns, self.filename, self, self.params, list(self.env_args),
-                     dict(self.args), list(self.arg_names), self.include_args,
-                     self.pass_all_args, self.include_stack)
+        return child_ns
 
     def include_child(self, ns: str | None, filename: str) -> Scope:
         """The scope an ``<include>`` tag's own ``<arg>``/``<env>`` children are read in."""

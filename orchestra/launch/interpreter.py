@@ -300,6 +300,8 @@ class Interpreter:
         try:
             if include_file is not None:
                 child = scope.include_child(ns, include_file)
+            elif entity.tag in ("node", "test"):
+                child = scope.node_child(ns)
             else:
                 child = scope.child(ns)
         except ScopeError as exc:
@@ -610,7 +612,7 @@ class Interpreter:
             self._warn(entity, f"illegal node name '{name}'")
         child = self._ns_and_clear_params(entity, scope, node_name=name)
         try:
-            param_scope = child.child(name)
+            param_scope = child.node_child(name)
         except ScopeError as exc:
             raise self._error(entity, str(exc), "name") from None
         param_scope.params = {}

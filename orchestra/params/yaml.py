@@ -382,15 +382,22 @@ def flatten(name: str, value: Any) -> list[tuple[str, Any]]:
     ``flatten('/ns', {'a': {'b': 1}, 'c': 2})`` -> ``[('/ns/a/b', 1), ('/ns/c', 2)]``. An empty
     dictionary contributes nothing; a global key inside a dictionary escapes the namespace.
     """
+    if not isinstance(value, dict):
+        return [(name, value)]
     out: list[tuple[str, Any]] = []
-    stack = [(name, value)]
+    # depth first, in the dictionaries' order: one iterator per open dictionary (no
+    # recursion: nesting is bounded by the caller, not by Python's stack)
+    stack = [(name, iter(value.items()))]
     while stack:
-        key, val = stack.pop()
-        if isinstance(val, dict):
-            for sub in reversed(list(val.items())):
-                stack.append((ns_join(key, str(sub[0])), sub[1]))
+        prefix, items = stack[-1]
+        for key, val in items:
+            full = ns_join(prefix, key if key.__class__ is str else str(key))
+            if isinstance(val, dict):
+                stack.append((full, iter(val.items())))
+                break
+            out.append((full, val))
         else:
-            out.append((key, val))
+            stack.pop()
     return out
 
 
