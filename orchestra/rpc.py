@@ -481,12 +481,15 @@ class ThreadedServer(socketserver.ThreadingMixIn, _XMLRPCServer):
     def port(self) -> int:
         return int(self.server_address[1])
 
-    def serve_forever(self, poll_interval: float = 0.5) -> None:
+    def serve_forever(self, poll_interval: float | None = 0.5) -> None:
         """Serve until ``shutdown()``, which wakes this loop at once.
 
         socketserver's loop only notices a shutdown at its next poll, so every stop of a
         node (its slave API) or of a master waited up to ``poll_interval`` (0.2 s for a
-        node): most of the time a Python node took to exit after SIGINT.
+        node): most of the time a Python node took to exit after SIGINT. ``None`` waits
+        for a request or the shutdown only: this server has nothing to do between requests
+        (``ThreadingMixIn`` reaps its threads as it starts new ones), and a node's slave
+        thread waking 5 times a second took the GIL from the node's own threads for nothing.
         """
         self._serving_done.clear()
         try:

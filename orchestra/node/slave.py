@@ -76,7 +76,7 @@ class SlaveServer:
         self.port = self._server.server_address[1]
         self.uri = f"http://{advertise_host}:{self.port}/"
         self._thread = threading.Thread(target=self._server.serve_forever,
-                                        kwargs={"poll_interval": 0.2},
+                                        kwargs={"poll_interval": None},
                                         name="slave-xmlrpc", daemon=True)
 
     def start(self) -> None:
