@@ -157,6 +157,20 @@ _SCALARS = (st.none() | st.booleans() | st.integers() | st.floats() | _NAMEISH
             | st.text(alphabet="/a", min_size=70, max_size=300))
 
 
+_WORDISH = st.text(alphabet=st.sampled_from(list("0123456789_.-+xXbBoeEaAfFinINT#@`!|/")),
+                   max_size=10)
+
+
+@settings(max_examples=500, deadline=None)
+@given(st.dictionaries(_NAMEISH, _WORDISH | st.lists(_WORDISH, max_size=3), max_size=6))
+def test_dump_params_of_number_like_words_is_pyyamls(params):
+    """Words YAML 1.1 reads as numbers or dates, or that start with an indicator, are
+    single-quoted as PyYAML quotes them; others of those characters are plain."""
+    expected = yaml.dump(params, Dumper=LaunchParamsDumper, default_flow_style=False)
+    assert dump_launch_params(params) == expected
+    assert plain_document(params) in (None, expected)
+
+
 @settings(max_examples=500, deadline=None)
 @given(st.dictionaries(_NAMEISH | st.text(alphabet="/a", min_size=118, max_size=126),
                        _SCALARS | st.lists(_SCALARS, max_size=3), max_size=6))
@@ -171,11 +185,13 @@ def test_dump_params_of_plain_names_and_numbers_is_pyyamls_too(params):
 def test_a_document_of_names_and_numbers_is_written_without_yaml():
     params = {"/a/rate": 10, "/a/frame": "base_link", "/a/gain": 0.5, "/b/path": "/x/y.yaml",
               "/b/on": True, "/b/big": 1e17, "/c": None, "/d": "", "/e": ["Motor State", 2],
-              "/f": [], "/g": "Input Ports"}
+              "/f": [], "/g": "Input Ports", "/h/device_id": "#1", "/h/product": "0601",
+              "/h/vendor": "1d27", "/h/yes": "yes", "/h/ten": "10", "/i": ["1e-9", "1.0e-9"],
+              "/j": "2024-01-31", "/k": "-", "/m": "10.68.0.20"}
     assert plain_document(params) == yaml.dump(params, Dumper=LaunchParamsDumper,
                                                default_flow_style=False)
     assert plain_document({}) == "{}\n"
-    for other in ({"/a": "yes"}, {"/a": "10"}, {"/a": "a: b"}, {"/a": [[1]]}, {"/a": {}},
+    for other in ({"/a": "a: b"}, {"/a": "a#b"}, {"/a": "'q'"}, {"/a": [[1]]}, {"/a": {}},
                   {"/" + "k" * 122: 1}, {"/a": b"x"}, {"/a": "~"}, {"/a": "a " * 40 + "b"},
                   {"/a b": 1}, {"/a": " a"}):
         assert plain_document(other) is None, other

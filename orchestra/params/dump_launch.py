@@ -3,9 +3,10 @@
 Scripts diff it against roslaunch's, so it is PyYAML's ``safe_dump`` byte for byte. Its own
 module (not rosparam's ``dump``) because ``orchestra launch --dump-params`` is a start-up-time
 path: it imports nothing of the XML-RPC client, and a document whose names and values are all
-plain (names, paths, words, numbers, booleans, lists of them: most launches) is written here
-without importing yaml at all (a sixth of a one-node ``--dump-params``). Every other document
-is PyYAML's (``dump_launch_yaml.py``); tests/test_params_yaml.py checks both against
+plain (names, paths, words, numbers, booleans, words YAML would read as numbers or dates,
+lists of them: most launches) is written here without importing yaml at all (a sixth of a
+one-node ``--dump-params``, a fifth of one that sets ``device_id`` to ``'#1'``). Every other
+document is PyYAML's (``dump_launch_yaml.py``); tests/test_params_yaml.py checks both against
 ``yaml.dump``.
 """
 from __future__ import annotations
@@ -21,6 +22,18 @@ _PLAIN_TEXT = re.compile(r"[A-Za-z_/][A-Za-z0-9_./-]*(?: [A-Za-z0-9_./-]+)*\Z")
 _NOT_TEXT = frozenset(("yes", "Yes", "YES", "no", "No", "NO", "true", "True", "TRUE", "false",
                        "False", "FALSE", "on", "On", "ON", "off", "Off", "OFF", "null", "Null",
                        "NULL"))
+#: text of these characters that PyYAML does not write plain is written single-quoted as it
+#: is (no quote to double, no space to fold at): YAML 1.1 reads it as a number or a date
+#: (``'0601'``, ``'1.5'``, ``'-1'``, ``'2024-01-31'``), it is a lone ``-`` or starts a
+#: document marker (``---``, ``...``), or it starts with an indicator (``'#1'``, ``'@x'``)
+_QUOTABLE = re.compile(r"[#&*!|>%@`]?[A-Za-z0-9_./+-]+\Z")
+#: what YAML 1.1 (PyYAML's implicit resolvers) reads as an int, a float or a date, for text of
+#: the characters above (sexagesimal numbers and full timestamps need a ':' or a space)
+_NOT_TEXT_NUMBER = re.compile(
+    r"[-+]?(?:0b[01_]+|0[0-7_]+|0|[1-9][0-9_]*|0x[0-9a-fA-F_]+)"         # int
+    r"|[-+]?[0-9][0-9_]*\.[0-9_]*(?:[eE][-+][0-9]+)?|\.[0-9][0-9_]*(?:[eE][-+][0-9]+)?"
+    r"|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN)"                            # float
+    r"|[0-9]{4}-[0-9]{2}-[0-9]{2}")                                        # date
 #: PyYAML folds plain text at a space past this column
 _WIDTH = 80
 #: PyYAML writes a longer key as ``? key`` (it counts the key's 5-character ``!!str`` tag into
@@ -30,16 +43,17 @@ _SIMPLE_KEY_MAX = 122
 
 def _plain_scalar(value: Any, before: int) -> str | None:
     """``value`` as PyYAML's safe dumper writes it after ``before`` characters of its line,
-    when that is one plain or empty scalar of the kinds above (text, exact ints, floats,
-    booleans, None); None for anything else."""
+    when that is one plain, empty or single-quoted scalar of the kinds above (text, exact
+    ints, floats, booleans, None); None for anything else."""
     kind = type(value)
     if kind is str:
         if not value:
             return "''"
-        if (_PLAIN_TEXT.match(value) is None or value in _NOT_TEXT
-                or (" " in value and before + len(value) > _WIDTH)):
-            return None
-        return value
+        if _PLAIN_TEXT.match(value) is not None:
+            if value in _NOT_TEXT:
+                return f"'{value}'"
+            return None if " " in value and before + len(value) > _WIDTH else value
+        return _quoted_word(value)
     if kind is bool:
         return "true" if value else "false"
     if kind is int:
@@ -55,6 +69,19 @@ def _plain_scalar(value: Any, before: int) -> str | None:
     if value is None:
         return "null"
     return None
+
+
+def _quoted_word(value: str) -> str | None:
+    """A word of ``_QUOTABLE``'s characters as PyYAML writes it: plain, unless YAML would
+    read it as something else than text or as an indicator (then single-quoted, see
+    ``_QUOTABLE``); None for any other text."""
+    if _QUOTABLE.match(value) is None:
+        return None
+    if (not value[0].isalnum() and value[0] not in "_./+-"  # a leading indicator
+            or value == "-" or value.startswith(("---", "..."))
+            or _NOT_TEXT_NUMBER.fullmatch(value) is not None):
+        return f"'{value}'"
+    return value
 
 
 def _entry(key: Any, value: Any) -> str | None:
