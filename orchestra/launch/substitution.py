@@ -53,9 +53,11 @@ class Scope(Protocol):
 
 
 def _find_package(name: str) -> str:
-    # imported lazily: the package index is only needed by files that use $(find)
-    from orchestra.packages import find_package
-    return find_package(name)
+    # imported lazily: the package index is only needed by files that use $(find). (A
+    # plain dotted import: ``from package import name`` runs importlib's Python fromlist
+    # handling on every call, a fifth of a $(find).)
+    import orchestra.packages.index
+    return orchestra.packages.index.find_package(name)
 
 
 _SIMPLE_GROUP = re.compile(r"\$\(([^$()]+)\)")
@@ -215,17 +217,37 @@ def resolve(text: str | None, scope: Scope) -> str | None:
     for token, parts in parsed:
         resolved = _first_pass(resolved, token, parts, scope)
     if "$" in resolved:
-        # $(find) last; what the first pass left (from arg values) is only checked for
-        # unknown commands, as roslaunch does
-        for body in collect(resolved):
-            parts = words(body)
-            problem = body_problem(body)
-            if problem is not None and (not parts or parts[0] not in COMMANDS
-                                        or parts[0] == "find"):
-                raise SubstitutionError(problem)
-            if parts[0] == "find":
-                resolved = _find(resolved, body, parts[1:])
+        for body, pkg_args in _finds(resolved):
+            resolved = _find(resolved, body, pkg_args)
     return resolved
+
+
+# The second pass's groups of a text (what the first pass left), checked, as _PARSED keeps
+# the first pass's: ``$(find pkg)/...`` texts are the same on many elements.
+_FINDS: dict[str, list[tuple[str, list[str]]]] = {}
+
+
+def _finds(resolved: str) -> list[tuple[str, list[str]]]:
+    """The ``$(find)`` groups of ``resolved`` as (body, its words after ``find``), in order.
+
+    $(find) goes last; what the first pass left (from arg values) is only checked for
+    unknown commands, as roslaunch does."""
+    found = _FINDS.get(resolved)
+    if found is not None:
+        return found
+    found = []
+    for body in collect(resolved):
+        parts = words(body)
+        problem = body_problem(body)
+        if problem is not None and (not parts or parts[0] not in COMMANDS
+                                    or parts[0] == "find"):
+            raise SubstitutionError(problem)
+        if parts[0] == "find":
+            found.append((body, parts[1:]))
+    if len(_FINDS) >= _PARSED_LIMIT:
+        _FINDS.clear()
+    _FINDS[resolved] = found
+    return found
 
 
 # ----------------------------------------------------------------------------- $(eval)
