@@ -1,4 +1,5 @@
 """Tag rules of the interpreter, on small launch files written for each behaviour."""
+import os
 import re
 import sys
 
@@ -86,6 +87,24 @@ def test_missing_include_names_the_include_line(write):
     with pytest.raises(OrchestraError) as info:
         launch(write, '\n<include file="/does/not/exist.launch"/>')
     assert "main.launch:2" in str(info.value) and "does not exist" in str(info.value)
+
+
+@pytest.mark.parametrize("target", ["missing.launch", "missing.launch.yaml", "a_directory",
+                                    "a_fifo"])
+def test_include_of_what_is_not_a_file_names_the_include_line(write, tmp_path, target):
+    (tmp_path / "a_directory").mkdir()
+    os.mkfifo(tmp_path / "a_fifo")
+    with pytest.raises(OrchestraError) as info:
+        launch(write, f'\n<include file="{tmp_path / target}"/>')
+    assert str(info.value).startswith(f"{tmp_path / 'main.launch'}:2: <include> ")
+    assert f"included file does not exist: [{tmp_path / target}]" in str(info.value)
+
+
+def test_include_of_a_broken_file_gives_the_files_own_error(write):
+    write("bad.launch", "<launch><node")
+    with pytest.raises(OrchestraError, match="invalid XML") as info:
+        launch(write, '<include file="$(dirname)/bad.launch"/>')
+    assert "bad.launch:1" in str(info.value)
 
 
 def test_private_params_apply_to_later_nodes_in_scope(write):

@@ -725,9 +725,15 @@ class Interpreter:
         if len(scope.include_stack) >= MAX_INCLUDE_DEPTH:
             raise self._error(entity, f"includes nest more than {MAX_INCLUDE_DEPTH} files deep",
                               "file")
-        if not os.path.isfile(filename):
-            raise self._error(entity, f"included file does not exist: [{filename}]", "file")
-        root = self._parse(filename)
+        try:
+            root = self._parse(filename)
+        except OrchestraError:
+            # a missing file is named as this <include>'s error, not the reader's (asked
+            # only on failure: a stat of every included file cost as much as its read)
+            if not os.path.isfile(filename):
+                raise self._error(entity, f"included file does not exist: [{filename}]",
+                                  "file") from None
+            raise
         child.include_stack = (*scope.include_stack, key)
         self.files.append(filename)
         try:
