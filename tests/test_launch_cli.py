@@ -1,8 +1,10 @@
 """``orchestra launch`` dump modes, through the real command line."""
 import json
 import os
+import signal
 import subprocess
 import sys
+import time
 
 import pytest
 
@@ -91,3 +93,32 @@ def test_stdin_launch_file(ws):
     proc = orchestra(ws, "-", "--dump-params", stdin='<launch><param name="x" value="1"/></launch>')
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.strip() == "/x: 1"
+
+
+@pytest.mark.parametrize("front", [[], ["-v"]], ids=["without-click", "through-click"])
+def test_ctrl_c_during_a_command_param_of_dump_params_ends_it_at_once(tmp_path, front):
+    """A dump starts nothing, so a Ctrl-C while a slow ``command=`` runs ends it with 130,
+    the command's process killed, no traceback (it used to be recorded for a supervisor
+    that a dump never has: the dump went on and exited 0)."""
+    pid_file = tmp_path / "pid"
+    launch = tmp_path / "slow.launch"
+    launch.write_text('<launch>\n  <param name="x" command="sh -c \'echo $$ > '
+                      f'{pid_file}; exec sleep 60\'"/>\n</launch>\n')
+    env = {**os.environ, "ROS_HOME": str(tmp_path / ".ros")}
+    proc = subprocess.Popen([sys.executable, "-m", "orchestra", *front, "launch",
+                             "--dump-params", str(launch)], env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 30
+        while not (pid_file.exists() and pid_file.read_text().strip()):
+            assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
+            time.sleep(0.02)
+        command_pid = int(pid_file.read_text())
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=30)
+    finally:
+        proc.kill()
+    assert proc.returncode == 130, err
+    assert "Traceback" not in err and out == ""
+    with pytest.raises(ProcessLookupError):
+        os.kill(command_pid, 0)

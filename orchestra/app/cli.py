@@ -17,7 +17,7 @@ from typing import Any
 
 import click
 
-from orchestra.app.launch_output import OUTPUT_OPTIONS, write_outputs
+from orchestra.app.launch_output import OUTPUT_OPTIONS, prints_and_exits, write_outputs
 from orchestra.completion import complete_launch_words
 from orchestra.errors import OrchestraError
 
@@ -217,6 +217,8 @@ def launch(ctx: click.Context, words: tuple[str, ...], core_only: bool, **option
 
     stop_signals.record()   # first: a Ctrl-C from here on is an orderly stop, never lost
     modes = {o.dest: options.pop(o.dest) for o in OUTPUT_OPTIONS}
+    if prints_and_exits(modes) or modes["ros_args"]:
+        stop_signals.release()   # it starts nothing: a Ctrl-C simply ends it
     run_opts = options
     cli_only = {k: run_opts.pop(k) for k in _CLI_ONLY}
     if cli_only.get("child_name") or cli_only.get("server_uri"):

@@ -144,9 +144,9 @@ def write_outputs(paths: list[str], args: dict[str, str], modes: dict[str, Any])
 def run_output_request(request: dict[str, Any]) -> None:
     """``orchestra launch`` for a ``parse_output_request`` answer, without click."""
     from orchestra.launch.load import split_words
-    from orchestra.supervise import stop_signals
 
-    stop_signals.record()   # as the click command does first
+    # no stop_signals.record() as a run has: this starts nothing, so a Ctrl-C (even during a
+    # slow command= param) simply ends it (KeyboardInterrupt: exit 130, the child killed)
     paths, args = split_words(request["words"])
     write_outputs(paths, args, request)
 

@@ -26,6 +26,21 @@ def record() -> None:
             signal.signal(sig, _record)
 
 
+def release() -> None:
+    """Stop recording: stop signals act as Python's defaults again (SIGINT raises
+    KeyboardInterrupt, SIGTERM and SIGHUP end the process), and one recorded meanwhile acts
+    now. For a command that turns out to start nothing (``orchestra launch --dump-params``):
+    there is nothing to stop in order, and nothing would take what is recorded, so a Ctrl-C
+    during a slow ``command=`` param must end it at once, as it ends roslaunch."""
+    if threading.current_thread() is not threading.main_thread():
+        return
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    for other in STOP_SIGNALS[1:]:
+        signal.signal(other, signal.SIG_DFL)
+    for sig in take():
+        signal.raise_signal(sig)
+
+
 def _record(signum: int, frame: object) -> None:
     _received.append(signum)   # atomic; safe even when it interrupts itself
 
