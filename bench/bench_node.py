@@ -10,6 +10,8 @@ machines; absolute numbers depend on the CPU and on what else runs.
     python bench/bench_node.py --quick    # fewer topic samples (~5 minutes)
     python bench/bench_node.py --rows service    # only the rospy service rows (issue 15)
     python bench/bench_node.py --rows twist100   # only the rospy 100 Hz latency rows
+    python bench/bench_node.py --rows twist100 --contend 1   # ... with the subscribers'
+                                                 # CPU kept busy by another process
 
 Processes: an in-process master, then a publisher process and a subscriber process (or a
 service and a client process). One-way latency = receive time - send time, both read from
@@ -45,8 +47,10 @@ per call is printed next to the rates.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
+import shutil
 import socket
 import statistics
 import struct
@@ -460,8 +464,12 @@ def main() -> None:
     parser.add_argument("--phases", default="", help="(phase_pub) seconds, one per topic")
     parser.add_argument("--subscribers", type=int, default=1,
                         help="(phase_pub) connections to wait for on each topic")
-    parser.add_argument("--twist100-count", type=int, default=600,
+    parser.add_argument("--twist100-count", type=int, default=1000,
                         help="100 Hz messages per compared pair and round")
+    parser.add_argument("--contend", type=int, default=0,
+                        help="CPU-bound processes kept busy on the subscribers' CPU during "
+                             "the 100 Hz rows (what another program on a robot's computer "
+                             "does to a subscriber's tail, reproducibly)")
     parser.add_argument("--cpu", type=int, default=None, help="(child roles) run on this CPU")
     opts = parser.parse_args()
     global IMPL
@@ -517,7 +525,9 @@ def main() -> None:
                         results["ros1"][f"{kind} {pub_impl}->{sub_impl}"] = bench_topic(
                             env, kind, count, burst, gap, pub_impl, sub_impl)
             if opts.rows in ("all", "twist100"):
-                results["twist100"] = twist100_rounds(env, opts.twist100_count, opts.rounds)
+                with contenders(opts.contend):
+                    results["twist100"] = twist100_rounds(env, opts.twist100_count, opts.rounds)
+                results["twist100"]["contend"] = opts.contend
             if opts.rows in ("all", "service"):
                 results["services"] = service_rounds(env, calls, persistent_calls, opts.rounds)
         else:
@@ -594,6 +604,21 @@ def twist100_rounds(env: dict, count: int, rounds: int, period: float = 0.01) ->
     return {"rounds": per_round,
             "pooled": {name: {k: summarize(v) for k, v in pairs.items()}
                        for name, pairs in pooled.items()}}
+
+
+@contextlib.contextmanager
+def contenders(count: int):
+    """``count`` busy-looping processes on the subscribers' CPU, each in its own session (as
+    an unrelated program would be), for the duration of the block."""
+    cpu = ["taskset", "-c", str(CPUS["sub"])] if CPUS and shutil.which("taskset") else []
+    procs = [subprocess.Popen([*cpu, sys.executable, "-c", "while True: pass"],
+                              start_new_session=True) for _ in range(count)]
+    try:
+        yield
+    finally:
+        for proc in procs:
+            proc.kill()
+            proc.wait()
 
 
 def phase_run(env: dict, subs: list[tuple[str, list[str]]],
@@ -737,8 +762,10 @@ def print_twist100(data: dict) -> None:
     pooled."""
     rounds, pooled = data["rounds"], data["pooled"]
     base = "rospy->rospy"
+    busy = f", {data['contend']} busy process(es) on the subscribers' CPU" \
+        if data.get("contend") else ""
     print(f"\nTwist 100 Hz latency, the two pairs of a comparison run at once, 5 ms apart "
-          f"({len(rounds)} rounds)")
+          f"({len(rounds)} rounds{busy})")
     for name, pair in TWIST100:
         col = pair_name(pair)
         print(f"{'  which ' + name + ' (us)':36}{col:>14}{base:>14}{'ratio':>9}")
