@@ -193,6 +193,24 @@ def test_spawn_failure_of_optional_node_leaves_others_running(tmp_path):
     assert result.exit_code == 1 and result.failed == ["/broken"]
 
 
+def test_nodes_sharing_a_missing_program_each_fail_and_a_new_cwd_is_made_once_per_batch(
+        tmp_path):
+    # a batch vets each (program, cwd, PATH) once: every node of it still gets the verdict
+    missing = str(tmp_path / "missing")
+    home = tmp_path / "home" / "deep"
+    specs = [ProcessSpec(f"/broken{i}", (missing, f"__name:=b{i}"), dict(os.environ), str(home))
+             for i in range(3)]
+    specs.append(ProcessSpec("/ok", ("/bin/sh", "-c", "sleep 100"), dict(os.environ), str(home),
+                             output=OutputMode.SCREEN))
+    sup = Supervisor(specs, FAST, screen=quiet_screen())
+    ok = sup.by_name("/ok")
+    result = run(sup, until=lambda: ok.state == State.RUNNING and ok.uptime > 0.2)
+    assert home.is_dir()
+    assert sorted(result.failed) == ["/broken0", "/broken1", "/broken2"]
+    for i in range(3):
+        assert "No such file or directory" in sup.by_name(f"/broken{i}").reason
+
+
 def test_all_nodes_finishing_ends_the_run_with_zero(tmp_path):
     sup = Supervisor([sh("/a", "exit 0", tmp_path), sh("/b", "exit 0", tmp_path)], FAST,
                      screen=quiet_screen())

@@ -157,9 +157,10 @@ class Supervisor:
             return
         ready: list[tuple[ManagedProcess, list[str]]] = []
         refused: tuple[ManagedProcess, OSError] | None = None
+        vetted: dict[tuple[str, str, str | None], OSError | None] = {}
         for proc in self.procs:
             try:
-                ready.append((proc, self._command(proc.spec)))
+                ready.append((proc, self._command(proc.spec, vetted)))
             except OSError as exc:
                 if proc.spec.required:   # the ones before it start, and are stopped
                     refused = (proc, exc)
@@ -353,13 +354,32 @@ class Supervisor:
         return _chain(child_setup(self._pid) if self.pdeathsig == "preexec" else None,
                       rlimit_setup(spec.limits))
 
-    def _command(self, spec: ProcessSpec) -> list[str]:
+    def _command(self, spec: ProcessSpec,
+                 vetted: dict[tuple[str, str, str | None], OSError | None] | None = None
+                 ) -> list[str]:
         """The argv to exec for ``spec``, or the OSError exec would give (checked here
-        because setpriv, not Popen, would meet it); creates the working directory."""
+        because setpriv, not Popen, would meet it); creates the working directory.
+
+        ``vetted`` remembers, for one batch of spawns, what was found for each (program,
+        working directory, PATH): a launch of many nodes of few types checks each type once
+        (~25 us of file system calls per node, all before the first node is spawned)."""
         argv = list(spec.argv)
-        os.makedirs(spec.cwd, exist_ok=True)
+        key = (argv[0], spec.cwd, spec.env.get("PATH"))
+        if vetted is not None and key in vetted:
+            problem = vetted[key]
+        else:
+            try:
+                os.makedirs(spec.cwd, exist_ok=True)
+                if self.pdeathsig == "setpriv":
+                    check_executable(argv[0], spec.env, spec.cwd)
+                problem = None
+            except OSError as exc:
+                problem = exc
+            if vetted is not None:
+                vetted[key] = problem
+        if problem is not None:
+            raise problem
         if self.pdeathsig == "setpriv":
-            check_executable(argv[0], spec.env, spec.cwd)
             argv = [*(setpriv_prefix() or ()), *argv]  # checked at __init__
         return argv
 
