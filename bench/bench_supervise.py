@@ -22,7 +22,12 @@
    SIGKILLed (orphans, then killed). Skipped with a message when roslaunch is missing.
    With each start row, where the CPU went until the last node ran (the scheduler's own
    accounting, /proc/PID/task/TID/schedstat): the launcher process, its other processes,
-   the nodes, and what the cores had in that time.
+   the nodes, and what the cores had in that time. Where ``perf`` can trace (root, or a low
+   perf_event_paranoid), each start row is also given by the kernel's own exec timestamps
+   (``sched:sched_process_exec``): launcher Popen until the kernel exec'd the last node
+   program, free of the probe's polling lag (the probe runs in its own session and so waits
+   its turn among the starting interpreters like everything else).
+   ``--start-only`` runs just the start/stop rows against roslaunch.
 """
 from __future__ import annotations
 
@@ -377,15 +382,109 @@ def schedstat(pid: int) -> tuple[float, float]:
     return ran / 1e6, waited / 1e6
 
 
-class Launcher:
-    """One ``roslaunch`` or ``orchestra launch`` run of a launch file, on its own port."""
+class ExecTrace:
+    """The kernel's exec timestamps of every process, recorded by ``perf`` for a while.
 
-    def __init__(self, kind: str, launch: str, root: str, extra: tuple[str, ...] = ()) -> None:
+    Why: the probe polls from its own session and so gets a turn only as often as any of the
+    100 starting interpreters; it saw a fast launcher's last node up to ~200 ms after the
+    kernel exec'd it (load ~9), a slow one's within a few ms. ``perf record`` of the
+    ``sched:sched_process_exec`` tracepoint on CLOCK_MONOTONIC (``time.monotonic``'s clock)
+    gives when each node program really started, the same way for both launchers.
+    """
+
+    def __init__(self, root: str) -> None:
+        self.data = os.path.join(root, "exec.perf")
+        self.proc: subprocess.Popen | None = None
+        self.execs: dict[int, list[tuple[float, str]]] = {}
+        perf = shutil.which("perf")
+        if perf is None:
+            self.problem = "perf not found"
+            return
+        self.proc = subprocess.Popen(
+            [perf, "record", "-q", "-a", "-k", "CLOCK_MONOTONIC",
+             "-e", "sched:sched_process_exec", "-o", self.data],
+            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        # recording once the file has its header (perf writes it when it is set up)
+        deadline = time.monotonic() + 10
+        while time.monotonic() < deadline and self.proc.poll() is None:
+            if os.path.exists(self.data) and os.path.getsize(self.data) > 0:
+                break
+            time.sleep(0.05)
+        time.sleep(0.3)
+        if self.proc.poll() is not None:
+            err = self.proc.stderr.read().decode(errors="replace") if self.proc.stderr else ""
+            self.problem = f"perf record failed: {err.strip().splitlines()[-1:] or ['?']}"
+            self.proc = None
+            return
+        self.problem = ""
+
+    def finish(self) -> None:
+        """Stop recording and read every exec: pid -> [(monotonic time, filename)]."""
+        if self.proc is None:
+            return
+        self.proc.send_signal(signal.SIGINT)
+        self.proc.wait(30)
+        out = subprocess.run(["perf", "script", "-i", self.data, "-F", "pid,time,trace"],
+                             capture_output=True, text=True).stdout
+        for line in out.splitlines():
+            head, _, trace = line.partition(": ")
+            words = head.split()
+            if len(words) < 2 or "filename=" not in trace:
+                continue
+            filename = trace.split("filename=", 1)[1].split(" pid=")[0]
+            self.execs.setdefault(int(words[0]), []).append((float(words[1]), filename))
+
+    def last_node_exec(self, pids: list[int]) -> float | None:
+        """When the kernel exec'd the last of ``pids``' node programs (None if one is
+        missing from the trace)."""
+        times = []
+        for pid in pids:
+            found = [t for t, filename in self.execs.get(pid, ()) if "rbench/scripts/" in filename]
+            if not found:
+                return None
+            times.append(found[0])
+        return max(times) if times else None
+
+
+#: "floor": a bare python3 that spawns n node commands as orchestra does (own session,
+#: setpriv's parent-death signal, stdout/stderr pipes, all at once on threads that stay,
+#: since the parent-death signal fires when the forking thread ends) and does nothing else:
+#: no master, no launch file. What any launcher written in Python could reach at best.
+FLOOR_SPAWNER = """
+import os, shutil, subprocess, sys, threading
+node, n = os.environ["BENCH_NODE"], int(sys.argv[1])
+setpriv = shutil.which("setpriv")
+prefix = [setpriv, "--pdeathsig", "KILL", "--"] if setpriv else []
+todo = list(range(n))
+def spawn():
+    while True:
+        try:
+            i = todo.pop()
+        except IndexError:
+            break
+        subprocess.Popen([*prefix, node, f"__name:=n{i:03d}"], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, start_new_session=True)
+    threading.Event().wait()
+for _ in range(n):
+    threading.Thread(target=spawn, daemon=True).start()
+threading.Event().wait()
+"""
+
+
+class Launcher:
+    """One ``roslaunch`` or ``orchestra launch`` run of a launch file, on its own port; or
+    (``floor``) a bare Python spawning ``node_program`` as many times (FLOOR_SPAWNER)."""
+
+    def __init__(self, kind: str, launch: str, root: str, extra: tuple[str, ...] = (),
+                 node_program: str = "", n: int = 0) -> None:
         port = free_port()
         uri = f"http://127.0.0.1:{port}/"
         self.kind = kind
         home = os.path.join(root, f"home_{kind}")
-        if kind == "roslaunch":
+        if kind == "floor":   # the program in the environment: the probe reads command lines
+            env = dict(os.environ, BENCH_NODE=node_program)
+            argv = [sys.executable, "-c", FLOOR_SPAWNER, str(n)]
+        elif kind == "roslaunch":
             env = ros1.base_env(ROS_PACKAGE_PATH=os.path.join(root, "ws"), ROS_HOME=home,
                                 ROS_MASTER_URI=uri)
             argv = [ros1.tool("roslaunch"), "-p", str(port), *extra, launch]
@@ -396,6 +495,7 @@ class Launcher:
             argv = [sys.executable, "-m", "orchestra", "launch", "--no-status", "--disable-title",
                     *extra, launch]
         self.t0 = time.perf_counter()
+        self.t0_monotonic = time.monotonic()
         self.proc = subprocess.Popen(argv, env=env, stdin=subprocess.DEVNULL,
                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                                      start_new_session=True)
@@ -403,6 +503,7 @@ class Launcher:
         self.seen: dict[int, psutil.Process] = {}    # node processes
         self.cpu: dict[str, float] = {}   # where the CPU went until all nodes ran (ms)
         self.others: list[psutil.Process] = []       # master, rosout: orphans once it is killed
+        self.node_pids: list[int] = []                # those found running the node program
 
     def wait_running(self, n: int, limit: float = 60.0) -> float:
         """Seconds from Popen until ``n`` node processes run (raises past ``limit``)."""
@@ -412,6 +513,7 @@ class Launcher:
                 if scan.poll() >= n:
                     took = time.perf_counter() - self.t0
                     self.cpu = self._accounting(scan.nodes, took)
+                    self.node_pids = list(scan.nodes)
                     return took
                 if self.proc.poll() is not None or time.perf_counter() - self.t0 > limit:
                     raise RuntimeError(f"{self.kind}: {len(scan.nodes)} of {n} nodes after "
@@ -474,14 +576,19 @@ class Launcher:
 TARGETS = {"start": "<= 0.25x", "SIGINT to launcher": "<= 0.15x"}
 
 
-def real_roslaunch_comparison(n: int, quick: bool) -> list:
-    """Rows (what, orchestra, roslaunch, note) for section 5."""
+def real_roslaunch_comparison(n: int, quick: bool, start_only: bool = False) -> list:
+    """Rows (what, orchestra, roslaunch, note) for section 5 (``start_only``: the start and
+    SIGINT rows only)."""
     rows: list = []
     with tempfile.TemporaryDirectory() as root:
+        trace = ExecTrace(root)
+        traced: list[tuple[str, str, float, list[int]]] = []   # what, kind, t0, node pids
         launch = make_py_workspace(root, n)
         launches = [("python", launch)]
+        programs = {"python": os.path.join(root, "ws", "rbench", "scripts", "sleeper")}
         if build_native_node(root):
             launches.append(("native", make_native_launch(root, n)))
+            programs["native"] = os.path.join(root, "ws", "rbench", "scripts", "native")
         else:
             rows.append([f"start {n} native nodes", "orchestra", None,
                          "skipped: no C compiler (cc) to build the native node"])
@@ -490,11 +597,16 @@ def real_roslaunch_comparison(n: int, quick: bool) -> list:
         for what, file in launches:
             times: dict[str, dict[str, list[float]]] = {}
             cpu: dict[str, list[dict[str, float]]] = {}
+            floor: list[float] = []
             for _ in range(repeat):
-                for kind in ("orchestra", "roslaunch"):
-                    run = Launcher(kind, file, root)
+                for kind in ("orchestra", "roslaunch", "floor"):
+                    run = Launcher(kind, file, root, node_program=programs[what], n=n)
                     try:
                         started = run.wait_running(n)
+                        traced.append((what, kind, run.t0_monotonic, run.node_pids))
+                        if kind == "floor":
+                            floor.append(started)
+                            continue
                         cpu.setdefault(kind, []).append(run.cpu)
                         time.sleep(1.0)  # let the launcher settle (registrations, rosout)
                         took, left = run.stop(40)
@@ -510,6 +622,10 @@ def real_roslaunch_comparison(n: int, quick: bool) -> list:
                              kind, statistics.median(figures["start"])])
                 rows.append([f"SIGINT to launcher -> launcher and {n} {what} nodes gone "
                              f"(median of {repeat})", kind, statistics.median(figures["stop"])])
+            label = f"  floor: a bare python3 spawning the same {n} {what} nodes, until all run"
+            rows.append([label, "orchestra", statistics.median(floor),
+                         "the floor in the orchestra column (FLOOR_SPAWNER)"])
+            rows.append([label, "roslaunch", statistics.median(times["roslaunch"]["start"])])
             for kind, runs in cpu.items():
                 med = {key: statistics.median(r[key] for r in runs) for key in runs[0]}
                 rows.append([f"  CPU until all {what} nodes ran (ms, medians)", kind, None,
@@ -517,6 +633,10 @@ def real_roslaunch_comparison(n: int, quick: bool) -> list:
                              f"{med['launcher waiting']:.0f}), master/rosout/helpers "
                              f"{med['others']:.0f}, nodes {med['nodes']:.0f}, "
                              f"of {med['available']:.0f} on {os.cpu_count()} cores"])
+        trace.finish()
+        rows += kernel_start_rows(trace, traced, n)
+        if start_only:
+            return merge_rows(rows)
         # SIGINT-ignoring nodes: default escalation, then --sigint-timeout
         stubborn = 3
         launch_x = make_py_workspace(root, 10, stubborn)
@@ -550,6 +670,50 @@ def real_roslaunch_comparison(n: int, quick: bool) -> list:
                              orphans, f"+{other_left} master/rosout processes"])
             finally:
                 run.kill()
+    return merge_rows(rows)
+
+
+def kernel_start_rows(trace: ExecTrace, traced: list[tuple[str, str, float, list[int]]],
+                      n: int) -> list:
+    """The start rows again, from the kernel's exec timestamps: launcher Popen until the
+    kernel exec'd its last node program; medians and the per-round ratios."""
+    if trace.problem:
+        return [[f"start {n} nodes by the kernel's exec timestamps", "orchestra", None,
+                 f"skipped: {trace.problem}"]]
+    rows: list = []
+    by: dict[tuple[str, str], list[float]] = {}
+    missing = False
+    for what, kind, t0, pids in traced:
+        last = trace.last_node_exec(pids)
+        if last is None:
+            missing = True
+            continue
+        by.setdefault((what, kind), []).append(last - t0)
+    if missing:
+        rows.append([f"start {n} nodes by the kernel's exec timestamps", "orchestra", None,
+                     "an exec missing from the trace: those runs left out"])
+    for what in dict.fromkeys(w for w, _ in by):
+        ours, theirs = by.get((what, "orchestra"), []), by.get((what, "roslaunch"), [])
+        if not ours or not theirs:
+            continue
+        label = (f"start {n} {what} nodes until the kernel exec'd the last "
+                 f"(median of {min(len(ours), len(theirs))})")
+        per_round = sorted(a / b for a, b in zip(ours, theirs, strict=False))
+        rows.append([label, "orchestra", statistics.median(ours),
+                     f"per round {statistics.median(per_round):.2f}x "
+                     f"[{per_round[0]:.2f}-{per_round[-1]:.2f}]"])
+        rows.append([label, "roslaunch", statistics.median(theirs)])
+        floor = by.get((what, "floor"), [])
+        if floor:
+            floor_label = f"  floor ({what} nodes, bare python3 spawner), the same way"
+            rows.append([floor_label, "orchestra", statistics.median(floor),
+                         "the floor in the orchestra column"])
+            rows.append([floor_label, "roslaunch", statistics.median(theirs)])
+    return rows
+
+
+def merge_rows(rows: list) -> list:
+    """One (what, orchestra, roslaunch, notes) row per measure."""
     merged: dict = {}
     for what, kind, value, *note in rows:
         entry = merged.setdefault(what, {"note": []})
@@ -568,6 +732,8 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true",
                         help="fewer kills, shorter idle window, no default-timeout escalation")
     parser.add_argument("--json", action="store_true", help="print the figures as JSON")
+    parser.add_argument("--start-only", action="store_true",
+                        help="only the start and SIGINT rows against roslaunch")
     args = parser.parse_args()
     if args.quick:
         args.kills, args.idle = min(args.kills, 10), min(args.idle, 2.0)
@@ -580,22 +746,23 @@ def main() -> None:
     if not args.json:
         print(ros1.load_average())
     figures: dict[str, float] = {}
-    figures.update(cold_start_and_idle_cpu(args.nodes, args.idle))
-    figures.update(respawn_latency(args.kills))
-    figures.update(stop_time(args.nodes))
+    if not args.start_only:
+        figures.update(cold_start_and_idle_cpu(args.nodes, args.idle))
+        figures.update(respawn_latency(args.kills))
+        figures.update(stop_time(args.nodes))
     real_rows = []
     if ros1.tool("roslaunch") is None:
         if not args.json:
             ros1.skip("the real roslaunch comparison", "roslaunch (ROS 1)")
     else:
-        real_rows = real_roslaunch_comparison(args.nodes, args.quick)
+        real_rows = real_roslaunch_comparison(args.nodes, args.quick, args.start_only)
     if args.json:
         figures["ros1"] = [{"what": w, "orchestra": o, "roslaunch": r, "note": note}
                            for w, o, r, note in real_rows]
         print(json.dumps(figures, indent=1))
         return
     n = args.nodes
-    rows = [
+    rows = [] if args.start_only else [
         (f"cold start, {n} nodes RUNNING (CLI, embedded master)", figures["cold"],
          figures["cold_baseline"], "-"),
         ("crash -> respawn latency, median", figures["respawn_median"],
@@ -606,11 +773,12 @@ def main() -> None:
         (f"stop {n} nodes, SIGINT to orchestra -> exit (CLI)", figures["cli_stop"],
          figures["stop_baseline"], "-"),
     ]
-    print(f"{'measure':<52} {'orchestra':>10} {'baseline':>10} {'ratio':>7}  target")
-    for label, value, base, target in rows:
-        print(f"{label:<52} {value:>9.3f}s {base:>9.3f}s {value / base:>7.2f}  {target}")
-    print(f"{'supervisor CPU, ' + str(n) + ' idle nodes (% of one core)':<52} "
-          f"{figures['idle_cpu']:>9.2f}% {'':>10} {'':>7}  < 1 %")
+    if rows:
+        print(f"{'measure':<52} {'orchestra':>10} {'baseline':>10} {'ratio':>7}  target")
+        for label, value, base, target in rows:
+            print(f"{label:<52} {value:>9.3f}s {base:>9.3f}s {value / base:>7.2f}  {target}")
+        print(f"{'supervisor CPU, ' + str(n) + ' idle nodes (% of one core)':<52} "
+              f"{figures['idle_cpu']:>9.2f}% {'':>10} {'':>7}  < 1 %")
     if real_rows:
         print(f"\n{'against real roslaunch (same launch file)':<80} {'orchestra':>10} "
               f"{'roslaunch':>10} {'ratio':>7}  target")
