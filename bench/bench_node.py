@@ -12,6 +12,8 @@ machines; absolute numbers depend on the CPU and on what else runs.
     python bench/bench_node.py --rows twist100   # only the rospy 100 Hz latency rows
     python bench/bench_node.py --rows twist100 --contend 1   # ... with the subscribers'
                                                  # CPU kept busy by another process
+    python bench/bench_node.py --orchestra-python /usr/bin/python3   # orchestra on the
+                                                 # ROS 1 interpreter build (see below)
 
 Processes: an in-process master, then a publisher process and a subscriber process (or a
 service and a client process). One-way latency = receive time - send time, both read from
@@ -23,6 +25,12 @@ calls/s rospy client->rospy service next to orchestra's. All pairs look each oth
 the same (orchestra) master, which is not on the measured path of topics (it is on a plain
 service call's: each call looks the service up, as rospy's does). Skipped with a message when
 rospy is missing.
+
+Interpreters: rospy runs on the ROS 1 interpreter (Debian's, built with PGO and LTO),
+orchestra on the one running this script; an interpreter built without those (pyenv's
+default) runs the same bytecode 1.2-1.4x slower, which is then in every ratio here.
+``--orchestra-python /usr/bin/python3`` runs orchestra's roles on the ROS 1 interpreter
+(with this one's site-packages on its path) to compare the implementations alone.
 
 Pinning (``--pin split``, the default on a machine with 2+ CPUs): every publisher and client
 runs on CPU 0, every subscriber and service on CPU 1, and this process (the master) on CPU
@@ -376,12 +384,29 @@ SPLIT = {"pub": 0, "client": 0, "raw_client": 0, "phase_pub": 0, "sub": 1, "mult
          "master": 1}
 
 
+#: the interpreter of orchestra's roles (--orchestra-python; None: this one)
+ORCHESTRA_PYTHON: str | None = None
+
+
+def orchestra_path() -> list[str]:
+    """What another interpreter of the same Python version needs on its path to run
+    orchestra as this one does: orchestra's source tree and this interpreter's
+    site-packages (its dependencies; the same minor version shares their binary ABI)."""
+    import sysconfig
+    root = os.path.dirname(os.path.dirname(HERE))
+    paths = sysconfig.get_paths()
+    return [root, *dict.fromkeys((paths["purelib"], paths["platlib"]))]
+
+
 def child(env: dict, role: str, *args: str, impl: str = "orchestra") -> subprocess.Popen:
     """A role in a child process: orchestra's interpreter, or the ROS 1 one for rospy."""
     if impl == "rospy":
         import ros1
         python = ros1.ROS1_PYTHON
         env = ros1.base_env(ROS_MASTER_URI=env["ROS_MASTER_URI"], PYTHONUNBUFFERED="1")
+    elif ORCHESTRA_PYTHON:
+        python = ORCHESTRA_PYTHON
+        env = dict(env, PYTHONPATH=os.pathsep.join(orchestra_path()))
     else:
         python = sys.executable
     pin = ["--cpu", str(CPUS[role])] if CPUS else []
@@ -470,6 +495,10 @@ def main() -> None:
                         help="CPU-bound processes kept busy on the subscribers' CPU during "
                              "the 100 Hz rows (what another program on a robot's computer "
                              "does to a subscriber's tail, reproducibly)")
+    parser.add_argument("--orchestra-python", default=None, metavar="PYTHON",
+                        help="run orchestra's roles with this interpreter (e.g. the ROS 1 "
+                             "one, /usr/bin/python3: the same interpreter build on both "
+                             "sides; it must be this one's minor version)")
     parser.add_argument("--cpu", type=int, default=None, help="(child roles) run on this CPU")
     opts = parser.parse_args()
     global IMPL
@@ -493,7 +522,8 @@ def main() -> None:
         return role_raw_server(opts.size, opts.count, opts.burst)
 
     scale = 0.25 if opts.quick else 1.0
-    global CPUS
+    global CPUS, ORCHESTRA_PYTHON
+    ORCHESTRA_PYTHON = opts.orchestra_python
     if opts.pin == "split" and hasattr(os, "sched_setaffinity") and len(os.sched_getaffinity(0)) >= 2:
         CPUS = SPLIT
         os.sched_setaffinity(0, {CPUS["master"]})  # before the master's threads start
@@ -547,6 +577,7 @@ def main() -> None:
     if "services" in results:
         print_services(results["services"])
     print(results["pinning"])
+    print(f"orchestra's roles ran on {opts.orchestra_python or sys.executable}")
     print(f"load average (1 min) {results['load_start'][0]:.2f} at the start, "
           f"{results['load_end'][0]:.2f} at the end, on {os.cpu_count()} cores")
 
