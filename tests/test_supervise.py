@@ -420,8 +420,10 @@ from orchestra.supervise.reaper import MARK_VARIABLE, Watchdog
 tmp = sys.argv[1]
 watchdog = Watchdog()
 if os.fork() == 0:   # a node caught between fork and exec, no parent-death signal yet
+    with open(os.path.join(tmp, "late"), "w") as pid_file:   # the same pid after the exec
+        pid_file.write(str(os.getpid()))
     time.sleep(0.4)
-    os.execve("/bin/sh", ["sh", "-c", "echo $$ > %s/late; exec sleep 1000" % tmp],
+    os.execve("/bin/sh", ["sh", "-c", "exec sleep 1000"],
               dict(os.environ, **{MARK_VARIABLE: watchdog.mark}))
 print("forked", flush=True)
 time.sleep(1000)
@@ -431,7 +433,8 @@ time.sleep(1000)
 def test_a_node_that_execs_after_orchestra_was_killed_is_still_killed(tmp_path):
     """The parent-death signal is set after the fork (setpriv) and the mark is seen only
     after the exec, so a node being spawned when orchestra is SIGKILLed escaped both the
-    signal and the watchdog's scan (a rosout left running by a killed ``orchestra core``)."""
+    signal and the watchdog's scan (a rosout left running by a killed ``orchestra core``).
+    The node writes its pid before the exec: the watchdog may kill it as soon as it execs."""
     proc = subprocess.Popen([sys.executable, "-c", SLOW_SPAWN, str(tmp_path)],
                             stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
     late = tmp_path / "late"
@@ -441,7 +444,7 @@ def test_a_node_that_execs_after_orchestra_was_killed_is_still_killed(tmp_path):
         proc.wait()
         deadline = time.monotonic() + 10
         while not (late.exists() and late.read_text().strip()):
-            assert time.monotonic() < deadline, "the late node never started"
+            assert time.monotonic() < deadline, "the late node never forked"
             time.sleep(0.02)
         assert wait_dead([int(late.read_text())]) == []
     finally:
