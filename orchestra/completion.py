@@ -8,9 +8,15 @@ they must be quick and must never fail (a broken launch file completes nothing).
 from __future__ import annotations
 
 import os
+from typing import TYPE_CHECKING
 
 import click
-from click.shell_completion import CompletionItem, get_completion_class
+
+if TYPE_CHECKING:
+    from click.shell_completion import CompletionItem
+
+# click.shell_completion is imported by the callbacks, not here: every `orchestra launch`
+# imports this module to name its callback, and the import is ~2.5 ms of its start-up.
 
 LAUNCH_SUFFIXES = (".launch", ".launch.xml", ".launch.yaml", ".launch.yml")
 
@@ -60,6 +66,8 @@ def _launch_file(words: list[str]) -> str | None:
 def complete_launch_words(ctx: click.Context, param: click.Parameter,
                           incomplete: str) -> list[CompletionItem]:
     """``orchestra launch [PKG] FILE [name:=value ...]``, word by word."""
+    from click.shell_completion import CompletionItem
+
     try:
         words = list(ctx.params.get(param.name or "", None) or ())
         positional = [w for w in words if ":=" not in w]
@@ -89,6 +97,8 @@ def complete_launch_words(ctx: click.Context, param: click.Parameter,
 def complete_node_names(ctx: click.Context, param: click.Parameter,
                         incomplete: str) -> list[CompletionItem]:
     """Node names of the orchestra launch at ROS_MASTER_URI."""
+    from click.shell_completion import CompletionItem
+
     try:
         from orchestra.master import master_uri_from_env
         from orchestra.supervise.status import launches_at
@@ -108,6 +118,8 @@ def completion(shell: str) -> None:
 
     Load it from the shell's start-up file, e.g. ``eval "$(orchestra completion bash)"``.
     """
+    from click.shell_completion import get_completion_class
+
     root = click.get_current_context().find_root().command
     cls = get_completion_class(shell)
     assert cls is not None
