@@ -61,6 +61,7 @@ import argparse
 import contextlib
 import json
 import os
+import random
 import shutil
 import socket
 import statistics
@@ -251,6 +252,12 @@ def role_multi_sub(topics: list[str]) -> None:
     rospy.signal_shutdown("done")
 
 
+#: each 100 Hz period starts up to this much late, at random (the same draw for both
+#: streams): something on the machine that wakes exactly every 2.56 s (or any multiple of
+#: 10 ms) otherwise always hits the same one of the two streams and decides its p99
+JITTER = 0.002
+
+
 def role_phase_pub(topics: list[str], phases: list[float], count: int, period: float,
                    subscribers: int) -> None:
     """Publish a Twist on each topic every ``period`` s at its own phase, on absolute times
@@ -264,11 +271,13 @@ def role_phase_pub(topics: list[str], phases: list[float], count: int, period: f
     while any(p.get_num_connections() < subscribers for p in pubs):
         time.sleep(0.01)
     emit({"connected": True})
-    t0 = float(sys.stdin.readline())
+    t0, seed = sys.stdin.readline().split()
+    jitter = random.Random(int(seed))  # the same draws in every publisher of the run
     order = sorted(zip(phases, pubs, strict=True), key=lambda x: x[0])
     for k in range(count):
+        start = float(t0) + k * period + jitter.uniform(0, JITTER)
         for phase, pub in order:
-            delay = t0 + k * period + phase - now()
+            delay = start + phase - now()
             if delay > 0:
                 time.sleep(delay)
             msg.linear.x = now()
@@ -618,8 +627,8 @@ def twist100_rounds(env: dict, count: int, rounds: int, period: float = 0.01) ->
     publisher and rospy's, both read by one rospy subscriber process. Both pairs of a
     comparison so see the same machine, sampled alternately every 5 ms, instead of two runs
     seconds apart whose p99s differ by what else ran then (on a shared machine that
-    difference was 0.2-6x). The phases swap every round; each round's p99 ratio and the
-    pooled one are kept."""
+    difference was 0.2-6x). The phases swap every round and each period starts up to
+    ``JITTER`` late at random; each round's p99 ratio and the pooled one are kept."""
     per_round: list[dict] = []
     pooled: dict[str, dict[str, list[float]]] = {}
     for i in range(rounds):
@@ -682,8 +691,9 @@ def phase_run(env: dict, subs: list[tuple[str, list[str]]],
         for proc in pub_procs:
             read(proc, "connected")
         t0 = now() + 0.3  # every publisher has its connections: a common start
+        seed = random.randrange(1 << 30)
         for proc in pub_procs:
-            tell(proc, repr(t0))
+            tell(proc, f"{t0!r} {seed}")
         for proc in pub_procs:
             read(proc, "latency_sent")
         samples: dict[str, list[float]] = {}
