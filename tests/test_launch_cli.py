@@ -122,3 +122,13 @@ def test_ctrl_c_during_a_command_param_of_dump_params_ends_it_at_once(tmp_path, 
     assert "Traceback" not in err and out == ""
     with pytest.raises(ProcessLookupError):
         os.kill(command_pid, 0)
+
+
+def test_an_unreadable_declared_encoding_is_one_located_line_and_exit_2(tmp_path):
+    launch = tmp_path / "bogus.launch"
+    launch.write_text('<?xml version="1.0" encoding="bogus"?>\n<launch/>\n')
+    proc = subprocess.run([sys.executable, "-m", "orchestra", "launch", "--dump-params",
+                           str(launch)], capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 2
+    assert proc.stderr.startswith(f"orchestra: error: {launch}:1: invalid XML: ")
+    assert "Traceback" not in proc.stderr

@@ -2,7 +2,7 @@
 import pytest
 
 from orchestra.errors import OrchestraError
-from orchestra.launch.xml import MAX_DEPTH, parse_file, parse_string
+from orchestra.launch.xml import MAX_DEPTH, parse_bytes, parse_file, parse_string
 
 
 def test_entities_carry_tag_attributes_children_and_lines():
@@ -86,6 +86,26 @@ def test_elements_nested_deeper_than_the_bound_are_refused_at_their_line():
     with pytest.raises(OrchestraError, match=f"nested more than {MAX_DEPTH} deep") as info:
         parse_string(doc(MAX_DEPTH + 1), "d")
     assert str(info.value).startswith("d:2:")
+
+
+@pytest.mark.parametrize("encoding", ["bogus", "utf-32", "shift_jis"])
+def test_an_encoding_expat_cannot_read_is_a_located_error(encoding):
+    with pytest.raises(OrchestraError, match="declared encoding cannot be read") as info:
+        parse_bytes(f'<?xml version="1.0" encoding="{encoding}"?>\n<launch/>\n'.encode(), "e.launch")
+    assert str(info.value).startswith("e.launch:1: ")
+
+
+def test_an_entity_declared_nowhere_read_is_refused_not_dropped():
+    # with an external DTD named (never read), expat would skip the reference in the text
+    # silently: inline YAML would lose a piece. (In an attribute value expat drops it
+    # without telling, as libxml2 did; an entity without a DTD is an error everywhere.)
+    doc = ('<!DOCTYPE launch SYSTEM "launch.dtd">\n<launch>\n'
+           '  <rosparam>a: x&foo;y</rosparam>\n</launch>\n')
+    with pytest.raises(OrchestraError, match="undefined entity &foo;") as info:
+        parse_string(doc, "u.launch")
+    assert str(info.value).startswith("u.launch:3:")
+    with pytest.raises(OrchestraError, match="undefined entity"):
+        parse_string('<launch><param name="a" value="x&foo;y"/></launch>', "u.launch")
 
 
 def test_missing_file_is_a_user_error(tmp_path):

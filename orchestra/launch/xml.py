@@ -117,21 +117,15 @@ def _decode(data: bytes) -> str:
         return data.decode("latin-1")  # positions of ASCII markup stay right
 
 
-class _EntityDeclared(Exception):
-    """Raised from expat's entity declaration handler to stop the parse (see the module);
-    ``offset`` is the byte offset expat was at, just after the declaration."""
+class _Refused(Exception):
+    """Raised from an expat handler to stop the parse at something this front end refuses
+    (see the module): an entity declaration, a reference to an entity it was not given,
+    nesting deeper than MAX_DEPTH. ``offset`` is the byte offset expat was at."""
 
-    def __init__(self, offset: int):
-        super().__init__()
+    def __init__(self, message: str, offset: int):
+        super().__init__(message)
+        self.message = message
         self.offset = offset
-
-
-class _TooDeep(Exception):
-    """Raised from the start tag handler at an element nested deeper than MAX_DEPTH."""
-
-    def __init__(self, location: Location):
-        super().__init__()
-        self.location = location
 
 
 def _read(data: bytes, filename: str, document: _Document) -> tuple[list[Entity], list[int]]:
@@ -147,8 +141,8 @@ def _read(data: bytes, filename: str, document: _Document) -> tuple[list[Entity]
 
     def start(tag: str, attributes: dict[str, str]) -> None:
         if len(open_entities) == MAX_DEPTH:
-            raise _TooDeep(Location(filename, parser.CurrentLineNumber,
-                                    parser.CurrentColumnNumber + 1))
+            raise _Refused(f"elements nested more than {MAX_DEPTH} deep",
+                           parser.CurrentByteIndex)
         if namespaced:
             attributes = {k: v for k, v in attributes.items()
                           if k != "xmlns" and not k.startswith("xmlns:")}
@@ -171,17 +165,27 @@ def _read(data: bytes, filename: str, document: _Document) -> tuple[list[Entity]
             innermost.text = data if before is None else before + data
 
     def entity_declared(*_: object) -> None:
-        raise _EntityDeclared(parser.CurrentByteIndex)
+        declared = data.rfind(b"<!ENTITY", 0, parser.CurrentByteIndex + 1)
+        raise _Refused("entity declarations (<!ENTITY>) are not allowed in launch files: use "
+                       "<arg> for values to reuse",
+                       declared if declared >= 0 else parser.CurrentByteIndex)
+
+    def entity_skipped(name: str, is_parameter_entity: bool) -> None:
+        # expat skips (rather than refuses) an entity it has no declaration of when the
+        # document names an external DTD, which is never read here
+        raise _Refused(f"undefined entity &{name};", parser.CurrentByteIndex)
 
     parser.StartElementHandler = start
     parser.EndElementHandler = end
     parser.CharacterDataHandler = text
     parser.EntityDeclHandler = entity_declared
+    parser.SkippedEntityHandler = entity_skipped
     try:
         parser.Parse(data, True)
     finally:  # the handlers and the parser refer to each other: no cycle left behind
         parser.StartElementHandler = parser.EndElementHandler = None
         parser.CharacterDataHandler = parser.EntityDeclHandler = None
+        parser.SkippedEntityHandler = None
     return entities, launches
 
 
@@ -199,16 +203,13 @@ def parse_bytes(data: bytes, filename: str) -> Entity:
         message = expat.ErrorString(exc.code) if exc.code else str(exc)
         raise LaunchSyntaxError(f"invalid XML: {message}",
                                 Location(filename, exc.lineno, exc.offset + 1)) from None
-    except _EntityDeclared as exc:
-        declared = data.rfind(b"<!ENTITY", 0, exc.offset + 1)
-        raise LaunchSyntaxError(
-            "invalid XML: entity declarations (<!ENTITY>) are not allowed in launch files: "
-            "use <arg> for values to reuse",
-            offset_location(filename, data, declared if declared >= 0 else exc.offset)) \
-            from None
-    except _TooDeep as exc:
-        raise LaunchSyntaxError(f"invalid XML: elements nested more than {MAX_DEPTH} deep",
-                                exc.location) from None
+    except _Refused as exc:
+        raise LaunchSyntaxError(f"invalid XML: {exc.message}",
+                                offset_location(filename, data, exc.offset)) from None
+    except (LookupError, ValueError) as exc:  # the XML declaration names an encoding expat
+        raise LaunchSyntaxError(                # cannot read (unknown, or multi-byte)
+            f"invalid XML: the declared encoding cannot be read: {exc}",
+            Location(filename, 1)) from None
     if len(launches) != 1:
         raise _launch_count_error(len(launches), filename)
     document.elements = len(entities)
