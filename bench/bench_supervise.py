@@ -735,6 +735,10 @@ def main() -> None:
     parser.add_argument("--start-only", action="store_true",
                         help="only the start and SIGINT rows against roslaunch")
     args = parser.parse_args()
+    # started in the background by a non-interactive shell (`cmd &`), this process ignores
+    # SIGINT and every node it starts would inherit that: the SIGINT rows would wait on nodes
+    # that cannot hear it. A handled signal is reset to its default in an exec'd child.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     if args.quick:
         args.kills, args.idle = min(args.kills, 10), min(args.idle, 2.0)
     # orchestra byte-compiled as an install leaves it (Debian's roslaunch is): with
