@@ -49,9 +49,7 @@ def _plain_scalar(value: Any, before: int) -> str | None:
     if kind is str:
         if not value:
             return "''"
-        if _PLAIN_TEXT.match(value) is not None:
-            if value in _NOT_TEXT:
-                return f"'{value}'"
+        if _PLAIN_TEXT.match(value) is not None and value not in _NOT_TEXT:
             return None if " " in value and before + len(value) > _WIDTH else value
         return _quoted_word(value)
     if kind is bool:
@@ -73,13 +71,13 @@ def _plain_scalar(value: Any, before: int) -> str | None:
 
 def _quoted_word(value: str) -> str | None:
     """A word of ``_QUOTABLE``'s characters as PyYAML writes it: plain, unless YAML would
-    read it as something else than text or as an indicator (then single-quoted, see
-    ``_QUOTABLE``); None for any other text."""
+    read it as something else than text (a boolean, null, a number, a date) or as an
+    indicator (then single-quoted, see ``_QUOTABLE``); None for any other text."""
     if _QUOTABLE.match(value) is None:
         return None
     if (not value[0].isalnum() and value[0] not in "_./+-"  # a leading indicator
             or value == "-" or value.startswith(("---", "..."))
-            or _NOT_TEXT_NUMBER.fullmatch(value) is not None):
+            or value in _NOT_TEXT or _NOT_TEXT_NUMBER.fullmatch(value) is not None):
         return f"'{value}'"
     return value
 
